@@ -1,0 +1,34 @@
+#include <cuda_runtime.h>
+
+#include <string>
+
+#include "core/gpu.h"
+
+namespace nebula {
+
+bool gpu_available(std::string* reason) {
+  int count = 0;
+  const cudaError_t status = cudaGetDeviceCount(&count);
+  if (status != cudaSuccess) {
+    if (reason) *reason = std::string("no usable CUDA device: ") + cudaGetErrorString(status);
+    cudaGetLastError();  // clear the sticky error so later queries start clean
+    return false;
+  }
+  if (count == 0) {
+    if (reason) *reason = "no CUDA device present";
+    return false;
+  }
+  return true;
+}
+
+std::string gpu_description() {
+  if (!gpu_available()) return "none";
+  cudaDeviceProp prop{};
+  int device = 0;
+  cudaGetDevice(&device);
+  cudaGetDeviceProperties(&prop, device);
+  return std::string(prop.name) + " (" + std::to_string(prop.multiProcessorCount) + " SMs, sm_" +
+         std::to_string(prop.major) + std::to_string(prop.minor) + ")";
+}
+
+}  // namespace nebula

@@ -1,0 +1,16 @@
+#pragma once
+// NEBULA_HD marks functions compiled for both host and device: physics is
+// written once and called from TBB on the CPU and from CUDA kernels.
+#if defined(__CUDACC__)
+#define NEBULA_HD __host__ __device__ inline
+#define NEBULA_DEVICE_CODE 1
+#else
+#define NEBULA_HD inline
+#endif
+
+// True inside the device pass of nvcc, where host-only facilities are absent.
+#if defined(__CUDA_ARCH__)
+#define NEBULA_ON_DEVICE 1
+#else
+#define NEBULA_ON_DEVICE 0
+#endif

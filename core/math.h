@@ -1,0 +1,21 @@
+#pragma once
+#include <cmath>
+
+#include "core/hd.h"
+
+namespace nebula {
+
+constexpr float kPi = 3.14159265358979323846f;
+constexpr double kPiD = 3.14159265358979323846;
+constexpr float kInv4Pi = 0.0795774715459476679f;
+
+// Radius of the sphere with the volume of a unit cube: the voxel sphere of
+// DESIGN.md (R = (3 / 4pi)^(1/3) l).
+constexpr double kVoxelSphereRadius = 0.62035049089940001667;
+
+template <class T>
+NEBULA_HD T clamp(T v, T lo, T hi) {
+  return v < lo ? lo : (v > hi ? hi : v);
+}
+
+}  // namespace nebula

@@ -1,0 +1,89 @@
+#include "montecarlo/slab.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/math.h"
+#include "montecarlo/test_stats.h"
+
+namespace nebula {
+namespace {
+
+// van de Hulst (1980), the MCML reference case (Wang, Jacques & Zheng 1995):
+// a = 0.9, g = 0.75, optical thickness 2, index 1, normal incidence.
+TEST(Slab, VanDeHulstReflectanceAndTransmittance) {
+  SlabParams p;
+  p.albedo = 0.9;
+  p.g = 0.75;
+  p.tau = 2.0;
+  p.photons = 4000000;
+  const SlabResult r = simulate_slab(p, Backend::Cpu);
+  EXPECT_NEAR(r.R_diffuse, 0.09739, 4 * r.R_stderr);
+  EXPECT_NEAR(r.T_total, 0.66096, 4 * r.T_stderr);
+  EXPECT_NEAR(r.T_unscattered, std::exp(-2.0), 1e-12);
+  EXPECT_EQ(r.capped_photons, 0u);
+}
+
+// Semi-infinite, isotropic, a = 0.8: R = 1 - H(1) sqrt(1 - a) with
+// Chandrasekhar's H(1) = 1.59822, i.e. 0.28525.
+TEST(Slab, SemiInfiniteIsotropicMatchesChandrasekhar) {
+  SlabParams p;
+  p.albedo = 0.8;
+  p.g = 0.0;
+  p.tau = 1e6;
+  p.photons = 1000000;
+  const SlabResult r = simulate_slab(p, Backend::Cpu);
+  EXPECT_NEAR(r.R_diffuse, 0.28525, 4 * r.R_stderr);
+  EXPECT_LT(r.T_total, 1e-9);
+}
+
+TEST(Slab, AnalogUnscatteredTransmissionFollowsBeerLambertAtOblique) {
+  SlabParams p;
+  p.albedo = 0.5;
+  p.g = 0.3;
+  p.tau = 0.7;
+  p.incidence_deg = 60;
+  p.photons = 400000;
+  p.forced_first_scattering = false;
+  validate(p);
+  const SlabTallies t = simulate_slab_cpu(p, nullptr);
+  const double expected = std::exp(-p.tau / 0.5);
+  const double got = from_fixed(t.unscattered) / p.photons;
+  EXPECT_NEAR(got, expected, 4 * std::sqrt(expected * (1 - expected) / p.photons));
+}
+
+TEST(Slab, ForcedAndAnalogAgree) {
+  SlabParams p;
+  p.albedo = 0.9;
+  p.g = 0.75;
+  p.tau = 0.3;
+  p.incidence_deg = 30;
+  p.photons = 400000;
+  const SlabResult forced = simulate_slab(p, Backend::Cpu);
+  p.forced_first_scattering = false;
+  p.seed = 17;
+  const SlabResult analog = simulate_slab(p, Backend::Cpu);
+  EXPECT_LT(std::fabs(test::z_score(forced.R_diffuse, forced.R_stderr, analog.R_diffuse,
+                                    analog.R_stderr)),
+            4.0);
+  EXPECT_LT(std::fabs(test::z_score(forced.T_total, forced.T_stderr, analog.T_total,
+                                    analog.T_stderr)),
+            4.0);
+  EXPECT_LT(forced.R_stderr, analog.R_stderr);
+}
+
+TEST(Slab, RefusesBadInput) {
+  SlabParams p;
+  p.tau = -1;
+  EXPECT_THROW(validate(p), Error);
+  p = {};
+  p.incidence_deg = 90;
+  EXPECT_THROW(validate(p), Error);
+  p = {};
+  p.photons = 0;
+  EXPECT_THROW(validate(p), Error);
+}
+
+}  // namespace
+}  // namespace nebula

@@ -1,0 +1,106 @@
+// CPU backend of the tabulator and the slab: TBB over chunks of photons, the
+// photon physics shared with the CUDA kernels.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <vector>
+
+#include "core/progress.h"
+#include "montecarlo/slab.h"
+#include "montecarlo/tabulate.h"
+
+namespace nebula {
+namespace {
+
+constexpr uint64_t kChunk = 2048;  // photons per task
+
+void atomic_add(uint64_t& target, uint64_t v) {
+  if (v) std::atomic_ref<uint64_t>(target).fetch_add(v, std::memory_order_relaxed);
+}
+
+struct CpuSphereSink {
+  std::vector<uint64_t> s1, s2;
+  uint64_t capped = 0, capped_weight = 0;
+  explicit CpuSphereSink(int n_mu) : s1(n_mu, 0), s2(n_mu, 0) {}
+  void add_bin(int k, uint64_t x, uint64_t x2) {
+    s1[k] += x;
+    s2[k] += x2;
+  }
+  void add_capped(uint64_t x) {
+    ++capped;
+    capped_weight += x;
+  }
+};
+
+}  // namespace
+
+SphereTallies tabulate_sphere_cpu(const TabulateParams& p, Progress* progress) {
+  SphereTallies t;
+  t.resize(p.tau_bins, p.mu_bins);
+  const uint64_t chunks_per_row = (p.photons_per_row + kChunk - 1) / kChunk;
+  std::vector<SphereRow> rows(p.tau_bins);
+  for (int i = 0; i < p.tau_bins; ++i) rows[i] = make_sphere_row(p, i);
+  const uint64_t tasks = chunks_per_row * p.tau_bins;
+  tbb::parallel_for(tbb::blocked_range<uint64_t>(0, tasks, 1), [&](const auto& range) {
+    for (uint64_t task = range.begin(); task != range.end(); ++task) {
+      // Heaviest (largest tau) rows first, for a short tail.
+      const int i = p.tau_bins - 1 - static_cast<int>(task / chunks_per_row);
+      const uint64_t begin = (task % chunks_per_row) * kChunk;
+      const uint64_t end = std::min(begin + kChunk, p.photons_per_row);
+      const SphereRow& row = rows[i];
+      CpuSphereSink sink(p.mu_bins);
+      uint64_t unscattered = 0, events = 0;
+      for (uint64_t photon = begin; photon < end; ++photon) {
+        const auto id = static_cast<uint32_t>(photon);
+        PhotonState st;
+        bool alive = false;
+        unscattered += to_fixed(launch_sphere_photon(row, id, st, alive));
+        while (alive) {
+          const Uniform4 u = row.stream.block(id, st.draw++);
+          const Fate f = scatter_and_fly(row.geometry, row.medium, row.roulette, u, st);
+          ++events;
+          if (f == Fate::Flying) continue;
+          alive = false;
+          tally_sphere_photon(row, st, f, sink);
+        }
+      }
+      for (int k = 0; k < p.mu_bins; ++k) {
+        atomic_add(t.sum_w[size_t(i) * p.mu_bins + k], sink.s1[k]);
+        atomic_add(t.sum_w2[size_t(i) * p.mu_bins + k], sink.s2[k]);
+      }
+      atomic_add(t.unscattered[i], unscattered);
+      atomic_add(t.events[i], events);
+      atomic_add(t.capped[i], sink.capped);
+      atomic_add(t.capped_weight[i], sink.capped_weight);
+      if (progress) progress->add(end - begin);
+    }
+  });
+  return t;
+}
+
+SlabTallies simulate_slab_cpu(const SlabParams& p, Progress* progress) {
+  const SlabRun run = make_slab_run(p);
+  SlabTallies total;
+  const uint64_t tasks = (p.photons + kChunk - 1) / kChunk;
+  tbb::parallel_for(tbb::blocked_range<uint64_t>(0, tasks, 1), [&](const auto& range) {
+    for (uint64_t task = range.begin(); task != range.end(); ++task) {
+      const uint64_t begin = task * kChunk, end = std::min(begin + kChunk, p.photons);
+      SlabTallies local;
+      for (uint64_t photon = begin; photon < end; ++photon)
+        run_slab_photon(run, static_cast<uint32_t>(photon), local);
+      atomic_add(total.sum_r, local.sum_r);
+      atomic_add(total.sum_r2, local.sum_r2);
+      atomic_add(total.sum_t, local.sum_t);
+      atomic_add(total.sum_t2, local.sum_t2);
+      atomic_add(total.unscattered, local.unscattered);
+      atomic_add(total.events, local.events);
+      atomic_add(total.capped, local.capped);
+      atomic_add(total.capped_weight, local.capped_weight);
+      if (progress) progress->add(end - begin);
+    }
+  });
+  return total;
+}
+
+}  // namespace nebula

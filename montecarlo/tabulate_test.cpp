@@ -1,0 +1,204 @@
+#include "montecarlo/tabulate.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "core/error.h"
+#include "core/math.h"
+#include "montecarlo/henyey_greenstein.h"
+#include "montecarlo/test_stats.h"
+
+namespace nebula {
+namespace {
+
+TabulateParams small_params() {
+  TabulateParams p;
+  p.tau_max = 10;
+  p.tau_bins = 11;
+  p.mu_bins = 36;
+  p.photons_per_row = 4000;
+  return p;
+}
+
+// Thin limit: P(tau, mu) / tau -> p_HG(mu) (DESIGN.md; exact normalisation
+// for the parallel beam), and 3/2 p_HG for the pencil beam, whose chord is the
+// diameter 2R instead of the mean chord 4R/3. Bin means of p_HG are exact.
+void expect_thin_limit(double g, Beam beam, double factor) {
+  TabulateParams p;
+  p.albedo = 0.6;
+  p.g = g;
+  p.tau_max = 1e-4;
+  p.tau_bins = 2;
+  p.mu_bins = 72;
+  p.photons_per_row = 1000000;
+  p.beam = beam;
+  p.seed = 3;
+  const Tabulation t = tabulate(p, Backend::Cpu);
+  const double tau = t.tau[1];
+  // First-order attenuation of light in and out of the sphere biases P/tau by
+  // at most sigma_ext x (longest chord) = 2 R tau / a each way.
+  const double bias = 2 * (2 * kVoxelSphereRadius * tau / p.albedo);
+  const AngularBins bins = t.bins();
+  for (int k = 0; k < p.mu_bins; ++k) {
+    const double expected = factor * hg_bin_mean(g, bins.edge(k), bins.edge(k + 1));
+    const double got = t.P[p.mu_bins + k] / tau;
+    const double se = t.P_stderr[p.mu_bins + k] / tau;
+    EXPECT_NEAR(got, expected, 4 * se + bias * expected)
+        << "g=" << g << " bin " << k << " z=" << (got - expected) / se;
+  }
+}
+
+TEST(Tabulate, ThinLimitIsTheHgPhaseFunction) {
+  for (double g : {-0.5, 0.0, 0.6, 0.9}) expect_thin_limit(g, Beam::Parallel, 1.0);
+}
+
+TEST(Tabulate, ThinLimitOfThePencilBeamIsThreeHalves) {
+  expect_thin_limit(0.6, Beam::Pencil, 1.5);
+}
+
+TEST(Tabulate, ZeroDepthRowIsEmptyAndTotalsMatchP) {
+  const TabulateParams p = small_params();
+  const Tabulation t = tabulate(p, Backend::Cpu);
+  const AngularBins bins = t.bins();
+  for (int k = 0; k < p.mu_bins; ++k) EXPECT_EQ(t.P[k], 0.0);
+  EXPECT_EQ(t.unscattered[0], 1.0);
+  const double area = kPiD * kVoxelSphereRadius * kVoxelSphereRadius;
+  for (int i = 0; i < p.tau_bins; ++i) {
+    double sum = 0;
+    for (int k = 0; k < p.mu_bins; ++k) sum += t.P[i * p.mu_bins + k] * bins.solid_angle(k) / area;
+    EXPECT_NEAR(sum, t.total[i], 1e-12 + 1e-12 * t.total[i]);
+    for (int k = 0; k < p.mu_bins; ++k) {
+      EXPECT_TRUE(std::isfinite(t.P[i * p.mu_bins + k]));
+      EXPECT_GE(t.P_stderr[i * p.mu_bins + k], 0.0);
+    }
+  }
+}
+
+TEST(Tabulate, SameSeedSameTableDifferentSeedDifferentTable) {
+  TabulateParams p = small_params();
+  const Tabulation a = tabulate(p, Backend::Cpu);
+  const Tabulation b = tabulate(p, Backend::Cpu);
+  EXPECT_EQ(a.P, b.P);
+  EXPECT_EQ(a.P_stderr, b.P_stderr);
+  EXPECT_EQ(a.scattering_events, b.scattering_events);
+  p.seed = 2;
+  const Tabulation c = tabulate(p, Backend::Cpu);
+  EXPECT_NE(a.P, c.P);
+}
+
+// Forced first scattering and Russian roulette change the variance, not the
+// expectation: the analog run agrees within 4 standard errors per entry.
+TEST(Tabulate, VarianceReductionIsUnbiased) {
+  TabulateParams p;
+  p.tau_max = 2;
+  p.tau_bins = 5;
+  p.mu_bins = 24;
+  p.photons_per_row = 200000;
+  const Tabulation forced = tabulate(p, Backend::Cpu);
+  p.forced_first_scattering = false;
+  p.roulette.threshold = 0.05f;
+  p.roulette.survival = 0.5f;
+  p.seed = 99;
+  const Tabulation analog = tabulate(p, Backend::Cpu);
+  for (size_t e = p.mu_bins; e < forced.P.size(); ++e)
+    EXPECT_LT(std::fabs(test::z_score(forced.P[e], forced.P_stderr[e], analog.P[e],
+                                      analog.P_stderr[e])),
+              4.0)
+        << "entry " << e;
+  for (int i = 1; i < p.tau_bins; ++i) {
+    EXPECT_LT(std::fabs(test::z_score(forced.total[i], forced.total_stderr[i], analog.total[i],
+                                      analog.total_stderr[i])),
+              4.0);
+    // The point of forcing: thin rows get much smaller errors for the same photons.
+  }
+  EXPECT_LT(forced.total_stderr[1], analog.total_stderr[1]);
+}
+
+// The 2005 paper's Fig. 4 (a = g = 0.6, its pencil beam through the centre):
+// the scattered fraction rises with tau, peaks and falls; at tau = 10 more
+// light leaves backward than forward. (Under the default parallel beam the
+// limb, optically thin, lets forward light out: there the two hemispheres are
+// about equal at tau = 10; docs/tabulator.md shows both.)
+TEST(Tabulate, ReproducesTheTrendsOfThePapersFigure4) {
+  TabulateParams p;
+  p.beam = Beam::Pencil;
+  p.tau_max = 10;
+  p.tau_bins = 21;
+  p.mu_bins = 72;
+  p.photons_per_row = 20000;
+  const Tabulation t = tabulate(p, Backend::Cpu);
+  const int n = p.tau_bins;
+  const int peak = int(std::max_element(t.total.begin(), t.total.end()) - t.total.begin());
+  ASSERT_GT(peak, 1);
+  ASSERT_LT(peak, n - 1);
+  auto separated = [&](int a, int b) {
+    return t.total[a] - t.total[b] >
+           4 * std::hypot(t.total_stderr[a], t.total_stderr[b]);
+  };
+  EXPECT_TRUE(separated(peak, 1)) << "rises from tau=" << t.tau[1];
+  EXPECT_TRUE(separated(peak, n - 1)) << "falls to tau=" << t.tau[n - 1];
+  const AngularBins bins = t.bins();
+  double back = 0, forward = 0, back_se = 0, forward_se = 0;
+  for (int k = 0; k < p.mu_bins; ++k) {
+    const size_t e = size_t(n - 1) * p.mu_bins + k;
+    const double w = bins.solid_angle(k);
+    (bins.centre(k) < 0 ? back : forward) += t.P[e] * w;
+    // Summing standard errors bounds the error of the sum from above.
+    (bins.centre(k) < 0 ? back_se : forward_se) += t.P_stderr[e] * w;
+  }
+  EXPECT_GT(back - forward, 4 * (back_se + forward_se));
+}
+
+TEST(Tabulate, RefusesBadParametersNamingTheOption) {
+  auto message = [](TabulateParams p) {
+    try {
+      validate(p);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  TabulateParams p;
+  p.albedo = 1.5;
+  EXPECT_NE(message(p).find("--albedo"), std::string::npos);
+  p = {};
+  p.g = 1.0;
+  EXPECT_NE(message(p).find("--g"), std::string::npos);
+  p.g = -1.0;
+  EXPECT_NE(message(p).find("--g"), std::string::npos);
+  p = {};
+  p.tau_max = 0;
+  EXPECT_NE(message(p).find("--tau-max"), std::string::npos);
+  p = {};
+  p.tau_bins = 1;
+  EXPECT_NE(message(p).find("--tau-bins"), std::string::npos);
+  p = {};
+  p.mu_bins = 1;
+  EXPECT_NE(message(p).find("--mu-bins"), std::string::npos);
+  p = {};
+  p.photons_per_row = 0;
+  EXPECT_NE(message(p).find("--photons"), std::string::npos);
+  EXPECT_EQ(message(TabulateParams{}), "accepted");
+}
+
+TEST(Tabulate, ExtremeParametersStayFinite) {
+  for (double g : {-0.99, 0.99}) {
+    for (double a : {0.0, 1e-3, 1.0}) {
+      TabulateParams p = small_params();
+      p.g = g;
+      p.albedo = a;
+      p.tau_max = 50;
+      p.photons_per_row = 500;
+      const Tabulation t = tabulate(p, Backend::Cpu);
+      for (double v : t.P) EXPECT_TRUE(std::isfinite(v) && v >= 0);
+      for (int i = 0; i < p.tau_bins; ++i) {
+        EXPECT_TRUE(std::isfinite(t.total[i]));
+        EXPECT_LE(t.total[i] + t.unscattered[i], 1.0 + 1e-6);
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace nebula
