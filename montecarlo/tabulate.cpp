@@ -135,6 +135,7 @@ Tabulation tabulate(const TabulateParams& p, Backend backend, Progress* progress
     tallies = tabulate_sphere_cpu(p, progress);
   }
   Tabulation out = finish_tabulation(p, tallies);
+  out.compute_seconds = tallies.compute_seconds;
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out.device = backend == Backend::Cuda ? gpu_description() : "cpu (TBB)";
   return out;

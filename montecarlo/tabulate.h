@@ -50,6 +50,7 @@ struct SphereTallies {
   std::vector<uint64_t> events;         // [n_tau], scattering events
   std::vector<uint64_t> capped;         // [n_tau], photons stopped by the order cap
   std::vector<uint64_t> capped_weight;  // [n_tau], their weight / weight_scale
+  double compute_seconds = 0;           // transport only (CUDA events on the GPU)
   void resize(int tau, int mu);
 };
 
@@ -62,7 +63,8 @@ struct Tabulation {
   uint64_t scattering_events = 0;
   uint64_t capped_photons = 0;
   double capped_weight = 0;  // largest per-row fraction of incident light lost to the cap
-  double seconds = 0;
+  double seconds = 0;          // end to end, allocation and copies included
+  double compute_seconds = 0;  // photon transport alone
   std::string device;
   AngularBins bins() const { return {params.binning, params.mu_bins}; }
   int n_tau() const { return params.tau_bins; }

@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <atomic>
+#include <chrono>
 #include <vector>
 
 #include "core/progress.h"
@@ -42,6 +43,7 @@ SphereTallies tabulate_sphere_cpu(const TabulateParams& p, Progress* progress) {
   std::vector<SphereRow> rows(p.tau_bins);
   for (int i = 0; i < p.tau_bins; ++i) rows[i] = make_sphere_row(p, i);
   const uint64_t tasks = chunks_per_row * p.tau_bins;
+  const auto start = std::chrono::steady_clock::now();
   tbb::parallel_for(tbb::blocked_range<uint64_t>(0, tasks, 1), [&](const auto& range) {
     for (uint64_t task = range.begin(); task != range.end(); ++task) {
       // Heaviest (largest tau) rows first, for a short tail.
@@ -76,6 +78,7 @@ SphereTallies tabulate_sphere_cpu(const TabulateParams& p, Progress* progress) {
       if (progress) progress->add(end - begin);
     }
   });
+  t.compute_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return t;
 }
 

@@ -16,6 +16,10 @@ namespace {
 using ull = unsigned long long;
 constexpr int kThreads = 256;
 constexpr uint32_t kSpherePhotonsPerBlock = 16384;  // 64 photons per thread
+// Resident blocks per SM the compiler must allow for (caps registers per thread).
+#ifndef NEBULA_SPHERE_MIN_BLOCKS
+#define NEBULA_SPHERE_MIN_BLOCKS 1
+#endif
 
 __device__ ull warp_sum(ull v) {
   for (int offset = 16; offset > 0; offset >>= 1) v += __shfl_down_sync(0xffffffffu, v, offset);
@@ -45,7 +49,7 @@ struct SharedSphereSink {
 // Grid: x = chunk of photons, y = row (heaviest rows first). Each thread
 // starts a new photon as soon as its last one ends, which keeps the warp's
 // lanes busy although photons live for very different numbers of events.
-__global__ void __launch_bounds__(kThreads) sphere_kernel(const SphereRow* rows, int row_end,
+__global__ void __launch_bounds__(kThreads, NEBULA_SPHERE_MIN_BLOCKS) sphere_kernel(const SphereRow* rows, int row_end,
                                                           uint32_t photons, int n_mu, ull* sum_w,
                                                           ull* sum_w2, ull* scalars) {
   extern __shared__ ull hist[];
@@ -137,6 +141,10 @@ SphereTallies tabulate_sphere_cuda(const TabulateParams& p, Progress* progress) 
   // With a progress bar, launch ~20 slices of rows and report after each;
   // without one, a single launch (no tail between slices).
   const int rows_per_launch = progress ? std::max(1, (n_tau + 19) / 20) : n_tau;
+  cudaEvent_t start, stop;
+  NEBULA_CUDA_CHECK(cudaEventCreate(&start));
+  NEBULA_CUDA_CHECK(cudaEventCreate(&stop));
+  NEBULA_CUDA_CHECK(cudaEventRecord(start));
   for (int row_end = n_tau; row_end > 0; row_end -= rows_per_launch) {
     const int count = std::min(rows_per_launch, row_end);
     sphere_kernel<<<dim3(chunks, count), kThreads, shared>>>(rows.ptr, row_end, photons, n_mu,
@@ -147,10 +155,16 @@ SphereTallies tabulate_sphere_cuda(const TabulateParams& p, Progress* progress) 
       progress->add(uint64_t(count) * photons);
     }
   }
-  NEBULA_CUDA_CHECK(cudaDeviceSynchronize());
+  NEBULA_CUDA_CHECK(cudaEventRecord(stop));
+  NEBULA_CUDA_CHECK(cudaEventSynchronize(stop));
+  float ms = 0;
+  NEBULA_CUDA_CHECK(cudaEventElapsedTime(&ms, start, stop));
+  cudaEventDestroy(start);
+  cudaEventDestroy(stop);
 
   SphereTallies t;
   t.resize(n_tau, n_mu);
+  t.compute_seconds = ms * 1e-3;
   const std::vector<ull> w = sum_w.download(), w2 = sum_w2.download(), s = scalars.download();
   std::copy(w.begin(), w.end(), t.sum_w.begin());
   std::copy(w2.begin(), w2.end(), t.sum_w2.begin());

@@ -1,0 +1,161 @@
+// `nebula slab`, `nebula validate montecarlo` and `nebula bench tabulate`.
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "app/commands.h"
+#include "app/output_path.h"
+#include "core/error.h"
+#include "core/progress.h"
+#include "montecarlo/slab.h"
+#include "validation/montecarlo_validation.h"
+#include "validation/tabulator_bench.h"
+
+namespace nebula::app {
+
+void add_slab_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "slab", "diffuse reflectance and total transmittance of a plane-parallel slab (index 1)");
+  struct Options {
+    SlabParams p;
+    std::string photons = "1e6", backend = "auto";
+    bool json = false, analog = false;
+  };
+  auto o = std::make_shared<Options>();
+  cmd->add_option("--albedo", o->p.albedo, "single-scattering albedo")->required();
+  cmd->add_option("--g", o->p.g, "HG asymmetry")->required();
+  cmd->add_option("--tau", o->p.tau, "optical thickness (extinction)")->required();
+  cmd->add_option("--incidence-deg", o->p.incidence_deg, "beam angle from the normal")->capture_default_str();
+  cmd->add_option("--photons", o->photons, "photons")->capture_default_str();
+  cmd->add_option("--seed", o->p.seed, "Philox key")->capture_default_str();
+  cmd->add_option("--backend", o->backend, "cpu, cuda or auto")->capture_default_str();
+  cmd->add_flag("--analog", o->analog, "no forced first scattering");
+  cmd->add_flag("--json", o->json, "print one JSON object");
+  cmd->callback([o] {
+    SlabParams p = o->p;
+    p.photons = parse_count("--photons", o->photons, 2, double(uint64_t(1) << 30));
+    p.forced_first_scattering = !o->analog;
+    validate(p);
+    const Backend backend = parse_backend(o->backend);
+    std::unique_ptr<Progress> progress;
+    if (!o->json) progress = std::make_unique<Progress>("slab", p.photons);
+    const SlabResult r = simulate_slab(p, backend, progress.get());
+    if (progress) progress->finish();
+    if (o->json) {
+      std::printf(
+          "{\"R_diffuse\": %.9g, \"R_stderr\": %.9g, \"T_total\": %.9g, \"T_stderr\": %.9g, "
+          "\"T_unscattered\": %.9g, \"photons\": %llu, \"scattering_events\": %llu, "
+          "\"capped_photons\": %llu, \"seconds\": %.6g, \"backend\": \"%s\"}\n",
+          r.R_diffuse, r.R_stderr, r.T_total, r.T_stderr, r.T_unscattered,
+          (unsigned long long)p.photons, (unsigned long long)r.scattering_events,
+          (unsigned long long)r.capped_photons, r.seconds, to_string(backend));
+      return;
+    }
+    std::printf("slab: a = %g, g = %g, tau = %g, incidence %g deg, %llu photons\n", p.albedo, p.g,
+                p.tau, p.incidence_deg, (unsigned long long)p.photons);
+    std::printf("diffuse reflectance   R = %.6f +- %.6f\n", r.R_diffuse, r.R_stderr);
+    std::printf("total transmittance   T = %.6f +- %.6f (unscattered %.6f, exact)\n", r.T_total,
+                r.T_stderr, r.T_unscattered);
+    std::printf("%.3g scattering events, %llu capped, %.3f s on %s\n", double(r.scattering_events),
+                (unsigned long long)r.capped_photons, r.seconds, r.device.c_str());
+  });
+}
+
+void add_validate_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand("validate", "check the physics against exact results");
+  cmd->require_subcommand(1);
+  auto* mc = cmd->add_subcommand("montecarlo", "the tabulator's transport against analytic answers");
+  auto backend = std::make_shared<std::string>("auto");
+  auto effort = std::make_shared<double>(1.0);
+  mc->add_option("--backend", *backend, "cpu, cuda or auto")->capture_default_str();
+  mc->add_option("--effort", *effort, "scale of the photon counts (tolerances follow)")
+      ->capture_default_str();
+  mc->callback([backend, effort] {
+    if (!(*effort > 0 && *effort <= 1000)) throw Error("--effort: must be in (0, 1000]");
+    const Backend b = parse_backend(*backend);
+    std::printf("validating the Monte-Carlo transport on %s\n\n", to_string(b));
+    const std::vector<ValidationRow> rows = validate_montecarlo(b, *effort);
+    std::printf("%-70s %11s %11s %10s  %s\n", "check", "expected", "measured", "tolerance", "result");
+    int failed = 0;
+    for (const ValidationRow& r : rows) {
+      std::printf("%-70s %11.6g %11.6g %10.3g  %s  (%s)\n", r.check.c_str(), r.expected, r.measured,
+                  r.tolerance, r.pass ? "pass" : "FAIL", r.basis.c_str());
+      failed += !r.pass;
+    }
+    std::printf("\nangular binning with 72 bins: the thin-limit table against p_HG (lookup as the "
+                "renderer does), and MC noise at 1e6 photons per row\n");
+    std::printf("%6s %-14s %12s %12s %14s %12s %12s\n", "g", "binning", "interp rms", "interp max",
+                "forward error", "noise rms", "combined");
+    for (const BinningRow& r : compare_binnings({0.0, 0.6, 0.9, 0.95}, 72, 1e6))
+      std::printf("%6.2f %-14s %11.3f%% %11.2f%% %13.2f%% %11.3f%% %11.3f%%\n", r.g,
+                  to_string(r.binning), 100 * r.interp_rms, 100 * r.interp_max,
+                  100 * r.forward_error, 100 * r.noise_rms, 100 * r.combined_rms);
+    std::printf("\n%zu passed, %d failed\n", rows.size() - failed, failed);
+    if (failed) throw Error(std::to_string(failed) + " validation check(s) failed");
+  });
+}
+
+void add_bench_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand("bench", "measure speed (medians after a warm-up)");
+  cmd->require_subcommand(1);
+  auto* tab = cmd->add_subcommand("tabulate", "photons and scattering events per second, CPU and CUDA; "
+                                              "table error against photons per row");
+  struct Options {
+    std::string backends = "auto";
+    int repeats = 5;
+    int tau_bins = 1000;
+    std::string photons = "1e6";
+    bool convergence = true;
+  };
+  auto o = std::make_shared<Options>();
+  tab->add_option("--backend", o->backends, "cpu, cuda, both or auto (= both when a GPU is present)")
+      ->capture_default_str();
+  tab->add_option("--repeats", o->repeats, "timed runs after the warm-up")->capture_default_str();
+  tab->add_option("--tau-bins", o->tau_bins, "rows of the GPU table")->capture_default_str();
+  tab->add_option("--photons", o->photons, "photons per row of the GPU table")->capture_default_str();
+  tab->add_flag("!--no-convergence", o->convergence, "skip the error-against-photons study");
+  tab->callback([o] {
+    if (o->repeats < 1) throw Error("--repeats: must be at least 1");
+    std::vector<Backend> backends;
+    if (o->backends == "both" || (o->backends == "auto" && gpu_available()))
+      backends = {Backend::Cpu, Backend::Cuda};
+    else
+      backends = {parse_backend(o->backends)};
+    const uint64_t gpu_photons = parse_count("--photons", o->photons, 2, double(kMaxPhotonsPerRow));
+    std::printf("| backend | device | table | photons/row | transport s (median of %d) | end-to-end s | "
+                "photons/s | events/s | events/photon |\n|---|---|---|---|---|---|---|---|---|\n",
+                o->repeats);
+    for (Backend b : backends) {
+      TabulateParams p;
+      p.tau_bins = o->tau_bins;
+      // The CPU measures a 1/100 slice of the work; rates are per photon and event.
+      p.photons_per_row = b == Backend::Cuda ? gpu_photons : std::max<uint64_t>(1000, gpu_photons / 100);
+      const ThroughputResult r = bench_throughput(b, p, o->repeats);
+      std::printf("| %s | %s | %d x %d | %.3g | %.4f | %.4f | %.3g | %.3g | %.2f |\n", r.backend.c_str(),
+                  r.device.c_str(), p.tau_bins, p.mu_bins, double(p.photons_per_row), r.median_seconds,
+                  r.median_wall, r.photons_per_second, r.events_per_second, r.events_per_photon);
+      std::fflush(stdout);
+    }
+    if (!o->convergence) return;
+    for (Backend b : backends) {
+      TabulateParams p;
+      std::vector<uint64_t> counts{1000, 10000, 100000, 1000000};
+      if (b == Backend::Cpu) {
+        p.tau_bins = 50;  // the CPU studies a 50-row table to stay within minutes
+        counts = {1000, 10000, 100000};
+      }
+      std::printf("\nerror against an independent 16x reference, %s, %d x %d table (a = %g, g = %g)\n",
+                  to_string(b), p.tau_bins, p.mu_bins, p.albedo, p.g);
+      std::printf("| photons/row | transport s | rel. L2 error | predicted from stderr | RMS z |\n"
+                  "|---|---|---|---|---|\n");
+      for (const ConvergenceRow& r : bench_convergence(b, p, counts, 16))
+        std::printf("| %.0e | %.4f | %.4g | %.4g | %.3f |\n", double(r.photons_per_row), r.seconds,
+                    r.rel_l2_error, r.predicted, r.rms_z);
+      std::fflush(stdout);
+    }
+  });
+}
+
+}  // namespace nebula::app

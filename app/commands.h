@@ -1,0 +1,13 @@
+#pragma once
+// Subcommands of the `nebula` command line; each registers itself on the app.
+#include <CLI/CLI.hpp>
+
+namespace nebula::app {
+
+void add_tabulate_command(CLI::App& app);
+void add_table_command(CLI::App& app);
+void add_slab_command(CLI::App& app);
+void add_validate_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
+
+}  // namespace nebula::app

@@ -1,0 +1,37 @@
+#include "app/output_path.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "core/error.h"
+
+namespace nebula::app {
+namespace {
+
+TEST(OutputPath, RefusesExistingMissingFolderAndFolders) {
+  const auto dir = std::filesystem::temp_directory_path() / "nebula_output_path_test";
+  std::filesystem::create_directories(dir);
+  const std::string file = (dir / "exists.h5").string();
+  std::ofstream(file) << "x";
+  EXPECT_THROW(check_output_path("-o", file, false), Error);
+  EXPECT_NO_THROW(check_output_path("-o", file, true));
+  EXPECT_THROW(check_output_path("-o", (dir / "missing" / "t.h5").string(), false), Error);
+  EXPECT_THROW(check_output_path("-o", dir.string(), true), Error);
+  EXPECT_NO_THROW(check_output_path("-o", (dir / "new.h5").string(), false));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(OutputPath, ParsesCounts) {
+  EXPECT_EQ(parse_count("--photons", "1e6", 2, 1e9), 1000000u);
+  EXPECT_EQ(parse_count("--photons", "250", 2, 1e9), 250u);
+  EXPECT_THROW(parse_count("--photons", "0", 2, 1e9), Error);
+  EXPECT_THROW(parse_count("--photons", "1.5", 1, 1e9), Error);
+  EXPECT_THROW(parse_count("--photons", "ten", 1, 1e9), Error);
+  EXPECT_THROW(parse_count("--photons", "1e6x", 1, 1e9), Error);
+  EXPECT_THROW(parse_count("--photons", "1e12", 1, 1e9), Error);
+}
+
+}  // namespace
+}  // namespace nebula::app

@@ -1,0 +1,25 @@
+#include "tables/table_lookup.h"
+
+#include <string>
+
+#include "core/error.h"
+#include "tables/scattering_table.h"
+
+namespace nebula {
+
+TableView view_of(const ScatteringTable& table) {
+  const size_t cells = static_cast<size_t>(table.n_tau()) * table.n_mu();
+  if (table.n_tau() < 2 || table.n_mu() < 1 || table.P.size() != cells)
+    throw Error("scattering table: /P: expected " + std::to_string(table.n_tau()) + " x " +
+                std::to_string(table.n_mu()) + " values with n_tau >= 2 and n_mu >= 1, found " +
+                std::to_string(table.P.size()));
+  TableView view;
+  view.P = table.P.data();
+  view.n_tau = table.n_tau();
+  view.n_mu = table.n_mu();
+  view.tau_max = static_cast<float>(table.tau_max());
+  view.bins = table.bins();
+  return view;
+}
+
+}  // namespace nebula

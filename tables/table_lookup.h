@@ -1,0 +1,89 @@
+#pragma once
+#include <type_traits>
+
+#include "core/angular_binning.h"
+#include "core/hd.h"
+#include "core/math.h"
+
+namespace nebula {
+
+struct ScatteringTable;
+
+// A non-owning view of P for lookups on host or device: P points to host
+// memory (view_of) or device memory (DeviceTable::view).
+struct TableView {
+  const float* P = nullptr;  // row-major [n_tau][n_mu]
+  int n_tau = 0;
+  int n_mu = 0;
+  float tau_max = 0.0f;
+  AngularBins bins;
+
+  // Bilinear in (tau, bin coordinate): linear in tau between rows and linear
+  // between bin centres. Beyond the outermost centres mu holds the edge value
+  // (still inside the mu domain, so not a clamp). A tau_sct above tau_max, a
+  // negative or NaN tau_sct, or a NaN mu is clamped to the table and counted
+  // once in *clamped, so callers can report how often they left the table.
+  NEBULA_HD float lookup(float tau_sct, float mu, int* clamped = nullptr) const {
+    if (P == nullptr || n_tau < 1 || n_mu < 1) return 0.0f;
+    bool outside = false;
+    float tau = tau_sct;
+    if (!(tau >= 0.0f)) {  // negative or NaN
+      tau = 0.0f;
+      outside = true;
+    } else if (tau > tau_max) {
+      tau = tau_max;
+      outside = true;
+    }
+    float u = 0.0f;
+    if (mu == mu) {
+      u = bins.position(mu) - 0.5f;  // continuous bin-centre index
+    } else {
+      outside = true;
+    }
+    if (outside && clamped != nullptr) *clamped += 1;
+
+    // The tau axis is uniform, so the row is found in O(1).
+    const float x = tau_max > 0.0f ? tau / tau_max * static_cast<float>(n_tau - 1) : 0.0f;
+    int i0, k0;
+    float ft, fu;
+    cell(x, n_tau, i0, ft);
+    cell(u, n_mu, k0, fu);
+    const int i1 = i0 + 1 < n_tau ? i0 + 1 : i0;
+    const int k1 = k0 + 1 < n_mu ? k0 + 1 : k0;
+
+    // Weighted form (not a + f (b - a)): exact at grid nodes and free of
+    // cancellation for non-negative P.
+    const float* row0 = P + static_cast<long long>(i0) * n_mu;
+    const float* row1 = P + static_cast<long long>(i1) * n_mu;
+    const float v0 = (1.0f - fu) * row0[k0] + fu * row0[k1];
+    const float v1 = (1.0f - fu) * row1[k0] + fu * row1[k1];
+    return (1.0f - ft) * v0 + ft * v1;
+  }
+
+  NEBULA_HD float at(int i_tau, int k_mu) const {
+    return P[static_cast<long long>(i_tau) * n_mu + k_mu];
+  }
+
+ private:
+  // Splits a node coordinate x (clamped to [0, n - 1]) into a lower node
+  // index and the fraction towards the next one; at x = n - 1 that is node
+  // n - 2 with fraction 1, so the last node is reproduced exactly.
+  NEBULA_HD static void cell(float x, int n, int& index, float& fraction) {
+    x = clamp(x, 0.0f, static_cast<float>(n - 1));
+    int i = static_cast<int>(x);
+    if (i > n - 2) i = n - 2;
+    if (i < 0) i = 0;
+    index = i;
+    fraction = x - static_cast<float>(i);
+  }
+};
+
+// Passed by value to kernels.
+static_assert(std::is_trivially_copyable_v<TableView>);
+
+// A host view of table.P; throws Error when P's size is not n_tau x n_mu
+// or n_tau < 2, so lookups can never read out of bounds. The table must
+// outlive the view.
+TableView view_of(const ScatteringTable& table);
+
+}  // namespace nebula

@@ -1,0 +1,79 @@
+#include "validation/tabulator_bench.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace nebula {
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace
+
+ThroughputResult bench_throughput(Backend backend, const TabulateParams& p, int repeats) {
+  ThroughputResult r;
+  r.backend = to_string(backend);
+  r.params = p;
+  r.repeats = repeats;
+  tabulate(p, backend);  // warm-up: context creation, module load, thread pool
+  std::vector<double> compute, wall;
+  uint64_t events = 0;
+  for (int i = 0; i < repeats; ++i) {
+    const Tabulation t = tabulate(p, backend);
+    compute.push_back(t.compute_seconds);
+    wall.push_back(t.seconds);
+    events = t.scattering_events;
+    r.device = t.device;
+  }
+  r.median_seconds = median(compute);
+  r.median_wall = median(wall);
+  const double photons = double(p.photons_per_row) * p.tau_bins;
+  r.photons_per_second = photons / r.median_seconds;
+  r.events_per_second = double(events) / r.median_seconds;
+  r.events_per_photon = double(events) / photons;
+  return r;
+}
+
+std::vector<ConvergenceRow> bench_convergence(Backend backend, const TabulateParams& base,
+                                              const std::vector<uint64_t>& counts, int ref_factor) {
+  TabulateParams ref_params = base;
+  ref_params.photons_per_row =
+      std::min<uint64_t>(*std::max_element(counts.begin(), counts.end()) * ref_factor, kMaxPhotonsPerRow);
+  ref_params.seed = base.seed + 1000003;  // independent of every run below
+  const Tabulation ref = tabulate(ref_params, backend);
+  double ref_norm = 0;
+  for (double v : ref.P) ref_norm += v * v;
+  ref_norm = std::sqrt(ref_norm);
+  std::vector<ConvergenceRow> rows;
+  for (uint64_t n : counts) {
+    TabulateParams p = base;
+    p.photons_per_row = n;
+    const Tabulation t = tabulate(p, backend);
+    ConvergenceRow row;
+    row.photons_per_row = n;
+    row.seconds = t.compute_seconds;
+    double err2 = 0, pred2 = 0, z2 = 0;
+    size_t nz = 0;
+    for (size_t e = 0; e < t.P.size(); ++e) {
+      const double d = t.P[e] - ref.P[e];
+      const double s2 = t.P_stderr[e] * t.P_stderr[e] + ref.P_stderr[e] * ref.P_stderr[e];
+      err2 += d * d;
+      pred2 += s2;
+      if (s2 > 0) {
+        z2 += d * d / s2;
+        ++nz;
+      }
+    }
+    row.rel_l2_error = std::sqrt(err2) / ref_norm;
+    row.predicted = std::sqrt(pred2) / ref_norm;
+    row.rms_z = nz ? std::sqrt(z2 / nz) : 0;
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+}  // namespace nebula

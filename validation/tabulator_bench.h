@@ -1,0 +1,38 @@
+#pragma once
+// Speed of the tabulator and its error against photon count (the numbers
+// behind docs/performance.md).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/backend.h"
+#include "montecarlo/tabulate.h"
+
+namespace nebula {
+
+struct ThroughputResult {
+  std::string backend, device;
+  TabulateParams params;
+  int repeats = 0;
+  double median_seconds = 0;  // transport time (CUDA events on the GPU), median of repeats
+  double median_wall = 0;     // end to end, allocation and copies included
+  double photons_per_second = 0, events_per_second = 0, events_per_photon = 0;
+};
+
+// One warm-up run, then `repeats` timed runs; medians.
+ThroughputResult bench_throughput(Backend backend, const TabulateParams& p, int repeats);
+
+struct ConvergenceRow {
+  uint64_t photons_per_row = 0;
+  double seconds = 0;       // transport time
+  double rel_l2_error = 0;  // ||P - P_ref|| / ||P_ref|| over the whole table
+  double predicted = 0;     // the same from the stated standard errors
+  double rms_z = 0;         // RMS of (P - P_ref) / sqrt(se^2 + se_ref^2): ~1 if errors are honest
+};
+
+// Error against an independent reference with `ref_factor` times the largest
+// photon count (another seed), for each photon count in `counts`.
+std::vector<ConvergenceRow> bench_convergence(Backend backend, const TabulateParams& base,
+                                              const std::vector<uint64_t>& counts, int ref_factor);
+
+}  // namespace nebula
