@@ -58,14 +58,14 @@ NEBULA_HD void sin_cos_2pi(float xi, float& s, float& c) {
 #endif
 }
 
-// Turns unit vector d by the polar angle (cos, sin) and azimuth 2 pi xi_phi.
-// The frame is built around d (no pole branch), and the result renormalised.
-NEBULA_HD Vec3 scatter_direction(Vec3 d, HgSample angle, float xi_phi) {
+// Turns unit vector d by the polar angle (cos, sin) and the azimuth whose
+// sine and cosine are given. The frame is built around d (no pole branch),
+// and the result renormalised.
+NEBULA_HD Vec3 scatter_direction(Vec3 d, HgSample angle, float sin_phi, float cos_phi) {
   Vec3 t, b;
   orthonormal_frame(d, t, b);
-  float s, c;
-  sin_cos_2pi(xi_phi, s, c);
-  return normalize((angle.sin_theta * c) * t + (angle.sin_theta * s) * b + angle.cos_theta * d);
+  return normalize((angle.sin_theta * cos_phi) * t + (angle.sin_theta * sin_phi) * b +
+                   angle.cos_theta * d);
 }
 
 // Host-side exact results, in double, for tests and validation.

@@ -78,7 +78,9 @@ TEST(HenyeyGreenstein, ScatterDirectionKeepsUnitLengthAndAngle) {
     for (uint32_t i = 0; i < 2000; ++i) {
       const Uniform4 u = philox_uniform4(11, 0, i, 0, 0);
       const float mu = 2 * u.u0 - 1;
-      const Vec3 out = scatter_direction(d, {mu, std::sqrt(1 - mu * mu)}, u.u1);
+      float sp, cp;
+      sin_cos_2pi(u.u1, sp, cp);
+      const Vec3 out = scatter_direction(d, {mu, std::sqrt(1 - mu * mu)}, sp, cp);
       EXPECT_NEAR(length(out), 1.0f, 1e-6f);
       EXPECT_NEAR(dot(out, d), mu, 2e-6f);
     }
@@ -88,7 +90,9 @@ TEST(HenyeyGreenstein, ScatterDirectionKeepsUnitLengthAndAngle) {
   const int n = 100000;
   for (uint32_t i = 0; i < n; ++i) {
     const Uniform4 u = philox_uniform4(12, 0, i, 0, 0);
-    const Vec3 out = scatter_direction({0, 0, 1}, {0.0f, 1.0f}, u.u1);
+    float sp, cp;
+    sin_cos_2pi(u.u1, sp, cp);
+    const Vec3 out = scatter_direction({0, 0, 1}, {0.0f, 1.0f}, sp, cp);
     sx += out.x;
     sy += out.y;
   }

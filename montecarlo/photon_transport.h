@@ -61,58 +61,68 @@ struct PhotonState {
   Vec3 dir;
   float weight_forced = 1;  // probability of the forced first interaction (1 if analog)
   float weight_albedo = 1;  // product of albedos and roulette factors
-  uint32_t draw = 1;        // next Philox block; block 0 belongs to the launch
+  uint32_t draw = 0;        // Philox blocks used; 0 means the photon is not yet emitted
   int orders = 0;           // scatterings so far
   NEBULA_HD float weight() const { return weight_forced * weight_albedo; }
 };
 
-enum class Fate : int { Flying = 0, Escaped, Absorbed, Capped };
+enum class Fate : int {
+  Flying = 0,    // at an interaction point, to be scattered by the next step
+  Escaped,       // left after at least one scattering
+  Unscattered,   // left without scattering (analog sampling, or tau = 0)
+  Absorbed,      // ended by Russian roulette
+  Capped,        // reached the order cap
+};
 
-// The first flight from the entry point. Returns the weight that leaves
-// unscattered; `alive` tells whether a scattering follows at st.pos.
-template <class Geometry>
-NEBULA_HD float first_flight(const Geometry& geometry, const Medium& m, bool forced, float u_path,
-                             PhotonState& st, bool& alive) {
-  const float d = geometry.exit_distance(st.pos, st.dir);
-  const float optical = m.sigma_ext * d;
-  if (forced) {
-    const float p_interact = -expm1f(-optical);
-    if (!(p_interact > 0.0f)) {
-      alive = false;
-      return 1.0f;
+// One step of a photon, the same on every backend: a photon not yet emitted
+// is placed by the source, any other scatters where it stands; then it flies
+// to its next interaction or out. Every step uses exactly one Philox block
+// (u0 polar angle or beam radius, u1 azimuth, u2 free path, u3 roulette) and
+// runs one shared path through sin/cos, the exit distance and the logarithm,
+// so the lanes of a GPU warp stay together whatever their photon is doing.
+// `unscattered` receives the weight that leaves without scattering.
+template <class Geometry, class Source>
+NEBULA_HD Fate transport_step(const Geometry& geometry, const Medium& m, const Roulette& rr,
+                              const Source& source, bool forced, const Uniform4& u,
+                              PhotonState& st, float& unscattered) {
+  float sin_phi, cos_phi;
+  sin_cos_2pi(u.u1, sin_phi, cos_phi);
+  const bool emitted_now = st.draw == 0;
+  ++st.draw;
+  unscattered = 0.0f;
+  if (emitted_now) {
+    source.emit(u.u0, sin_phi, cos_phi, st);
+    st.weight_forced = 1.0f;
+    st.weight_albedo = 1.0f;
+    st.orders = 0;
+  } else {
+    st.weight_albedo *= m.albedo;
+    st.dir = scatter_direction(st.dir, hg_sample(m.g, u.u0), sin_phi, cos_phi);
+    ++st.orders;
+    if (st.weight_albedo < rr.threshold) {
+      if (u.u3 >= rr.survival) return Fate::Absorbed;
+      st.weight_albedo /= rr.survival;
     }
-    const float s = -log1pf(-u_path * p_interact) / m.sigma_ext;
-    st.pos = st.pos + fminf(s, d) * st.dir;
-    st.weight_forced = p_interact;
-    alive = true;
-    return expf(-optical);
-  }
-  const float s = -logf(u_path) / m.sigma_ext;
-  if (!(s < d)) {
-    alive = false;
-    return 1.0f;
-  }
-  st.pos = st.pos + s * st.dir;
-  st.weight_forced = 1.0f;
-  alive = true;
-  return 0.0f;
-}
-
-// Scatters at st.pos, plays roulette, and flies to the next interaction or out.
-// Uses one Philox block: u0 polar angle, u1 azimuth, u2 free path, u3 roulette.
-template <class Geometry>
-NEBULA_HD Fate scatter_and_fly(const Geometry& geometry, const Medium& m, const Roulette& rr,
-                               const Uniform4& u, PhotonState& st) {
-  st.weight_albedo *= m.albedo;
-  st.dir = scatter_direction(st.dir, hg_sample(m.g, u.u0), u.u1);
-  ++st.orders;
-  if (st.weight_albedo < rr.threshold) {
-    if (u.u3 >= rr.survival) return Fate::Absorbed;
-    st.weight_albedo /= rr.survival;
   }
   const float d = geometry.exit_distance(st.pos, st.dir);
-  const float s = -logf(u.u2) / m.sigma_ext;
-  if (!(s < d)) return Fate::Escaped;
+  // Free path from exp(-sigma s), truncated to the chord on a forced first flight.
+  float truncation = 1.0f;
+  if (emitted_now && forced) {
+    const float optical = m.sigma_ext * d;
+    truncation = -expm1f(-optical);  // probability of interacting before the exit
+    if (!(truncation > 0.0f)) {
+      unscattered = 1.0f;
+      return Fate::Unscattered;
+    }
+    unscattered = expf(-optical);
+    st.weight_forced = truncation;
+  }
+  const float s = -log1pf(-u.u2 * truncation) / m.sigma_ext;
+  if (!(s < d)) {
+    if (st.orders > 0) return Fate::Escaped;
+    unscattered = 1.0f;
+    return Fate::Unscattered;
+  }
   st.pos = st.pos + s * st.dir;
   return st.orders >= rr.max_orders ? Fate::Capped : Fate::Flying;
 }

@@ -41,7 +41,8 @@ SlabRun make_slab_run(const SlabParams& p) {
   run.roulette = p.roulette;
   run.stream = {p.seed, 0u, kPurposeSlab};
   const double theta = p.incidence_deg * kPiD / 180.0;
-  run.incident = {static_cast<float>(std::sin(theta)), 0.0f, static_cast<float>(std::cos(theta))};
+  run.source.incident = {static_cast<float>(std::sin(theta)), 0.0f,
+                         static_cast<float>(std::cos(theta))};
   run.forced_first = p.forced_first_scattering;
   return run;
 }

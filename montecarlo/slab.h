@@ -23,12 +23,21 @@ struct SlabParams {
   Roulette roulette;
 };
 
+// A collimated beam entering the slab at the origin.
+struct SlabBeam {
+  Vec3 incident;
+  NEBULA_HD void emit(float, float, float, PhotonState& st) const {
+    st.pos = {0.0f, 0.0f, 0.0f};
+    st.dir = incident;
+  }
+};
+
 struct SlabRun {
   SlabGeometry geometry;
+  SlabBeam source;
   Medium medium;  // sigma_ext = 1: lengths in mean free paths
   Roulette roulette;
   PhotonStream stream;
-  Vec3 incident;
   bool forced_first;
 };
 
@@ -58,26 +67,22 @@ SlabTallies simulate_slab_cuda(const SlabParams& p, Progress* progress);
 // Adds the weight photon `photon` deposits into the slab tallies; host/device.
 NEBULA_HD void run_slab_photon(const SlabRun& run, uint32_t photon, SlabTallies& t) {
   PhotonState st;
-  st.pos = {0.0f, 0.0f, 0.0f};
-  st.dir = run.incident;
-  const Uniform4 u = run.stream.block(photon, 0);
-  bool alive = false;
-  const float unscattered = first_flight(run.geometry, run.medium, run.forced_first, u.u2, st, alive);
-  // Unscattered light leaves through the far face (normal incidence or oblique alike).
-  float transmitted = unscattered, reflected = 0.0f;
-  t.unscattered += to_fixed(unscattered);
-  while (alive) {
-    const Fate f = scatter_and_fly(run.geometry, run.medium, run.roulette,
-                                   run.stream.block(photon, st.draw++), st);
-    ++t.events;
-    if (f == Fate::Flying) continue;
-    alive = false;
-    if (f == Fate::Escaped) {
-      (st.dir.z > 0.0f ? transmitted : reflected) += st.weight();
-    } else if (f == Fate::Capped) {
-      ++t.capped;
-      t.capped_weight += to_fixed(st.weight());
-    }
+  float transmitted = 0.0f, reflected = 0.0f;
+  Fate f = Fate::Flying;
+  while (f == Fate::Flying) {
+    float left_unscattered;
+    f = transport_step(run.geometry, run.medium, run.roulette, run.source, run.forced_first,
+                       run.stream.block(photon, st.draw), st, left_unscattered);
+    // Unscattered light leaves through the far face.
+    transmitted += left_unscattered;
+    t.unscattered += to_fixed(left_unscattered);
+  }
+  t.events += st.orders;
+  if (f == Fate::Escaped) {
+    (st.dir.z > 0.0f ? transmitted : reflected) += st.weight();
+  } else if (f == Fate::Capped) {
+    ++t.capped;
+    t.capped_weight += to_fixed(st.weight());
   }
   t.sum_r += to_fixed(reflected);
   t.sum_r2 += to_fixed(reflected * reflected);

@@ -54,12 +54,12 @@ double weight_scale(const TabulateParams& p, int row) {
 SphereRow make_sphere_row(const TabulateParams& p, int row) {
   SphereRow r{};
   r.geometry.radius = static_cast<float>(kVoxelSphereRadius);
+  r.source = {p.beam, r.geometry.radius};
   const double sigma_ext = p.albedo > 0 ? tau_of_row(p, row) / p.albedo : 0.0;
   r.medium = {static_cast<float>(sigma_ext), static_cast<float>(p.albedo), static_cast<float>(p.g)};
   r.roulette = p.roulette;
   r.stream = {p.seed, static_cast<uint32_t>(row), kPurposeSphere};
   r.bins = {p.binning, p.mu_bins};
-  r.beam = p.beam;
   r.forced_first = p.forced_first_scattering;
   const double scale = weight_scale(p, row);
   r.inv_weight_scale = scale > 0 ? static_cast<float>(1.0 / scale) : 0.0f;

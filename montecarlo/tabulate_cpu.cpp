@@ -56,16 +56,14 @@ SphereTallies tabulate_sphere_cpu(const TabulateParams& p, Progress* progress) {
       for (uint64_t photon = begin; photon < end; ++photon) {
         const auto id = static_cast<uint32_t>(photon);
         PhotonState st;
-        bool alive = false;
-        unscattered += to_fixed(launch_sphere_photon(row, id, st, alive));
-        while (alive) {
-          const Uniform4 u = row.stream.block(id, st.draw++);
-          const Fate f = scatter_and_fly(row.geometry, row.medium, row.roulette, u, st);
-          ++events;
-          if (f == Fate::Flying) continue;
-          alive = false;
-          tally_sphere_photon(row, st, f, sink);
+        Fate f = Fate::Flying;
+        while (f == Fate::Flying) {
+          float left_unscattered;
+          f = sphere_step(row, id, st, left_unscattered);
+          unscattered += to_fixed(left_unscattered);
         }
+        events += st.orders;
+        tally_sphere_photon(row, st, f, sink);
       }
       for (int k = 0; k < p.mu_bins; ++k) {
         atomic_add(t.sum_w[size_t(i) * p.mu_bins + k], sink.s1[k]);

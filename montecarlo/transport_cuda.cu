@@ -18,7 +18,7 @@ constexpr int kThreads = 256;
 constexpr uint32_t kSpherePhotonsPerBlock = 16384;  // 64 photons per thread
 // Resident blocks per SM the compiler must allow for (caps registers per thread).
 #ifndef NEBULA_SPHERE_MIN_BLOCKS
-#define NEBULA_SPHERE_MIN_BLOCKS 1
+#define NEBULA_SPHERE_MIN_BLOCKS 4  // 64 registers: 5% faster than 71 on an H200
 #endif
 
 __device__ ull warp_sum(ull v) {
@@ -46,38 +46,41 @@ struct SharedSphereSink {
   }
 };
 
-// Grid: x = chunk of photons, y = row (heaviest rows first). Each thread
-// starts a new photon as soon as its last one ends, which keeps the warp's
-// lanes busy although photons live for very different numbers of events.
-__global__ void __launch_bounds__(kThreads, NEBULA_SPHERE_MIN_BLOCKS) sphere_kernel(const SphereRow* rows, int row_end,
-                                                          uint32_t photons, int n_mu, ull* sum_w,
-                                                          ull* sum_w2, ull* scalars) {
+// Grid: x = chunk of photons, y = row (heaviest rows first). A thread takes
+// the block's next photon as soon as its last one ends, so the lanes of a warp
+// stay busy although photons live for very different numbers of steps, and
+// every step runs the same code (transport_step) for every lane.
+__global__ void __launch_bounds__(kThreads, NEBULA_SPHERE_MIN_BLOCKS)
+    sphere_kernel(const SphereRow* rows, int row_end, uint32_t photons, int n_mu, ull* sum_w,
+                  ull* sum_w2, ull* scalars) {
   extern __shared__ ull hist[];
+  __shared__ uint32_t next_photon;
+  const uint32_t begin = blockIdx.x * kSpherePhotonsPerBlock;
+  const uint32_t end = min(photons, begin + kSpherePhotonsPerBlock);
   for (int k = threadIdx.x; k < 2 * n_mu; k += blockDim.x) hist[k] = 0;
+  if (threadIdx.x == 0) next_photon = begin;
   __syncthreads();
   const int i = row_end - 1 - static_cast<int>(blockIdx.y);
   const SphereRow row = rows[i];
-  const uint32_t begin = blockIdx.x * kSpherePhotonsPerBlock;
-  const uint32_t end = min(photons, begin + kSpherePhotonsPerBlock);
   SharedSphereSink sink{hist, n_mu};
   ull unscattered = 0, events = 0;
   PhotonState st;
-  bool alive = false;
-  uint32_t photon = 0, next = begin + threadIdx.x;
+  uint32_t photon = 0;
+  bool active = false;
   while (true) {
-    if (!alive) {
-      if (next >= end) break;
-      photon = next;
-      next += blockDim.x;
-      unscattered += to_fixed(launch_sphere_photon(row, photon, st, alive));
-      if (!alive) continue;
+    if (!active) {
+      photon = atomicAdd(&next_photon, 1u);
+      if (photon >= end) break;
+      st.draw = 0;
+      active = true;
     }
-    const Uniform4 u = row.stream.block(photon, st.draw++);
-    const Fate f = scatter_and_fly(row.geometry, row.medium, row.roulette, u, st);
-    ++events;
+    float left_unscattered;
+    const Fate f = sphere_step(row, photon, st, left_unscattered);
+    if (left_unscattered > 0.0f) unscattered += to_fixed(left_unscattered);
     if (f == Fate::Flying) continue;
-    alive = false;
+    events += st.orders;
     tally_sphere_photon(row, st, f, sink);
+    active = false;
   }
   warp_add_to(&scalars[4 * i + 0], unscattered);
   warp_add_to(&scalars[4 * i + 1], events);

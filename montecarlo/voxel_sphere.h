@@ -17,37 +17,38 @@ enum class Beam : int {
 
 inline const char* to_string(Beam b) { return b == Beam::Parallel ? "parallel" : "pencil"; }
 
+// Light falling on the voxel sphere along +z.
+struct SphereBeam {
+  Beam beam;
+  float radius;
+  // u and the azimuth place the photon uniformly on the cross-section (parallel)
+  // or at the near pole (pencil).
+  NEBULA_HD void emit(float u, float sin_phi, float cos_phi, PhotonState& st) const {
+    if (beam == Beam::Parallel) {
+      const float rho = radius * sqrtf(u);
+      st.pos = {rho * cos_phi, rho * sin_phi, -sqrtf(fmaxf(radius * radius - rho * rho, 0.0f))};
+    } else {
+      st.pos = {0.0f, 0.0f, -radius};
+    }
+    st.dir = {0.0f, 0.0f, 1.0f};
+  }
+};
+
 struct SphereRow {
   SphereGeometry geometry;
+  SphereBeam source;
   Medium medium;
   Roulette roulette;
   PhotonStream stream;
   AngularBins bins;
-  Beam beam;
   bool forced_first;
   float inv_weight_scale;  // tallies hold weight / scale, kept in [0, 2)
 };
 
-// Places photon `photon` on the sphere moving along +z and makes its first
-// flight. Returns the unscattered weight; `alive` says whether it scatters.
-NEBULA_HD float launch_sphere_photon(const SphereRow& row, uint32_t photon, PhotonState& st,
-                                     bool& alive) {
-  const Uniform4 u = row.stream.block(photon, 0);
-  const float r = row.geometry.radius;
-  if (row.beam == Beam::Parallel) {
-    // Uniform on the disc of radius r, entering on the sphere's near side.
-    const float rho = r * sqrtf(u.u0);
-    float s, c;
-    sin_cos_2pi(u.u1, s, c);
-    st.pos = {rho * c, rho * s, -sqrtf(fmaxf(r * r - rho * rho, 0.0f))};
-  } else {
-    st.pos = {0.0f, 0.0f, -r};
-  }
-  st.dir = {0.0f, 0.0f, 1.0f};
-  st.weight_albedo = 1.0f;
-  st.draw = 1;
-  st.orders = 0;
-  return first_flight(row.geometry, row.medium, row.forced_first, u.u2, st, alive);
+NEBULA_HD Fate sphere_step(const SphereRow& row, uint32_t photon, PhotonState& st,
+                           float& unscattered) {
+  return transport_step(row.geometry, row.medium, row.roulette, row.source, row.forced_first,
+                        row.stream.block(photon, st.draw), st, unscattered);
 }
 
 }  // namespace nebula
