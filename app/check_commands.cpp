@@ -11,7 +11,7 @@
 #include "core/progress.h"
 #include "montecarlo/slab.h"
 #include "validation/montecarlo_validation.h"
-#include "validation/tabulator_bench.h"
+#include "validation/benchmarks.h"
 
 namespace nebula::app {
 
@@ -153,6 +153,38 @@ void add_bench_command(CLI::App& app) {
       for (const ConvergenceRow& r : bench_convergence(b, p, counts, 16))
         std::printf("| %.0e | %.4f | %.4g | %.4g | %.3f |\n", double(r.photons_per_row), r.seconds,
                     r.rel_l2_error, r.predicted, r.rms_z);
+      std::fflush(stdout);
+    }
+  });
+
+  auto* bake = cmd->add_subcommand("bake", "per-star optical-depth bake of a noise grid, CPU and CUDA");
+  struct BakeOptions {
+    std::string backends = "auto";
+    int size = 256, stars = 4, repeats = 5;
+  };
+  auto b = std::make_shared<BakeOptions>();
+  bake->add_option("--backend", b->backends, "cpu, cuda, both or auto")->capture_default_str();
+  bake->add_option("--size", b->size, "voxels per grid edge")->capture_default_str();
+  bake->add_option("--stars", b->stars, "stars (one inside the grid, the others outside)")
+      ->capture_default_str();
+  bake->add_option("--repeats", b->repeats, "timed runs after the warm-up")->capture_default_str();
+  bake->callback([b] {
+    if (b->size < 2 || b->size > 1024) throw Error("--size: must be 2 to 1024");
+    if (b->stars < 1 || b->stars > 64) throw Error("--stars: must be 1 to 64");
+    if (b->repeats < 1) throw Error("--repeats: must be at least 1");
+    std::vector<Backend> backends;
+    if (b->backends == "both" || (b->backends == "auto" && gpu_available()))
+      backends = {Backend::Cpu, Backend::Cuda};
+    else
+      backends = {parse_backend(b->backends)};
+    std::printf("| backend | grid | stars | bake s (median of %d) | star-voxels/s |\n|---|---|---|---|---|\n",
+                b->repeats);
+    for (Backend backend : backends) {
+      // The CPU bakes one star (then scales): a 256^3 bake per star takes minutes on 2 cores.
+      const int stars = backend == Backend::Cpu ? 1 : b->stars;
+      const BakeBenchResult r = bench_bake(backend, b->size, stars, backend == Backend::Cpu ? 1 : b->repeats);
+      std::printf("| %s | %d^3 | %d | %.4f | %.3g |\n", r.backend.c_str(), r.size, r.stars, r.median_seconds,
+                  r.voxels_per_second);
       std::fflush(stdout);
     }
   });

@@ -5,8 +5,7 @@
 
 namespace nebula {
 
-// Minimal float vector usable on host and device; host-only linear algebra
-// uses Eigen instead.
+// Minimal float vector usable on host and device.
 struct Vec3 {
   float x = 0, y = 0, z = 0;
 };

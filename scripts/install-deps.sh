@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake pkg-config
-  libeigen3-dev libtbb-dev libhdf5-dev libcli11-dev libgtest-dev
+  libtbb-dev libhdf5-dev libcli11-dev libgtest-dev
   python3-numpy python3-matplotlib python3-h5py
 )
 

@@ -1,12 +1,15 @@
-#include "validation/tabulator_bench.h"
+#include "validation/benchmarks.h"
 
 #include <algorithm>
 #include <cmath>
 
+#include "core/philox.h"
+#include "illumination/optical_depth_bake.h"
+
 namespace nebula {
 namespace {
 
-double median(std::vector<double> v) {
+double median_of(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
@@ -29,8 +32,8 @@ ThroughputResult bench_throughput(Backend backend, const TabulateParams& p, int 
     events = t.scattering_events;
     r.device = t.device;
   }
-  r.median_seconds = median(compute);
-  r.median_wall = median(wall);
+  r.median_seconds = median_of(compute);
+  r.median_wall = median_of(wall);
   const double photons = double(p.photons_per_row) * p.tau_bins;
   r.photons_per_second = photons / r.median_seconds;
   r.events_per_second = double(events) / r.median_seconds;
@@ -74,6 +77,31 @@ std::vector<ConvergenceRow> bench_convergence(Backend backend, const TabulatePar
     rows.push_back(row);
   }
   return rows;
+}
+
+BakeBenchResult bench_bake(Backend backend, int size, int stars, int repeats) {
+  DensityGrid grid;
+  grid.shape.nx = grid.shape.ny = grid.shape.nz = size;
+  grid.tau_v.resize(grid.shape.count());
+  for (size_t c = 0; c < grid.tau_v.size(); ++c)
+    grid.tau_v[c] = 2.0f * philox_uniform4(31, 0, uint32_t(c), 0, 0).u0;
+  std::vector<Vec3> positions;
+  for (int s = 0; s < stars; ++s) {
+    const float f = float(size);
+    positions.push_back(s == 0 ? Vec3{0.45f * f, 0.52f * f, 0.47f * f}
+                               : Vec3{-0.5f * f * s, 0.3f * f, 1.2f * f});
+  }
+  BakeBenchResult r;
+  r.backend = to_string(backend);
+  r.size = size;
+  r.stars = stars;
+  r.repeats = repeats;
+  bake_star_depths(grid, positions, backend);  // warm-up
+  std::vector<double> times;
+  for (int i = 0; i < repeats; ++i) times.push_back(bake_star_depths(grid, positions, backend).seconds);
+  r.median_seconds = median_of(times);
+  r.voxels_per_second = double(grid.shape.count()) * stars / r.median_seconds;
+  return r;
 }
 
 }  // namespace nebula

@@ -1,6 +1,6 @@
 #pragma once
-// Speed of the tabulator and its error against photon count (the numbers
-// behind docs/performance.md).
+// Speed studies behind docs/performance.md: the tabulator (throughput and
+// error against photons) and the illumination bake.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -34,5 +34,17 @@ struct ConvergenceRow {
 // photon count (another seed), for each photon count in `counts`.
 std::vector<ConvergenceRow> bench_convergence(Backend backend, const TabulateParams& base,
                                               const std::vector<uint64_t>& counts, int ref_factor);
+
+
+struct BakeBenchResult {
+  std::string backend;
+  int size = 0, stars = 0, repeats = 0;
+  double median_seconds = 0;   // all stars, compute only (CUDA events on the GPU)
+  double voxels_per_second = 0;  // star-voxel pairs per second
+};
+
+// Per-star optical-depth bake of a size^3 grid of Philox noise (tau_v in
+// [0, 2)) lit by `stars` stars, one inside the grid and the rest outside.
+BakeBenchResult bench_bake(Backend backend, int size, int stars, int repeats);
 
 }  // namespace nebula

@@ -1,0 +1,96 @@
+#include "illumination/extinction.h"
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "core/error.h"
+
+namespace nebula {
+namespace {
+
+std::string number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
+
+// Horner evaluation of c[0] + c[1] y + ... + c[n-1] y^(n-1).
+template <size_t N>
+double polynomial(const double (&c)[N], double y) {
+  double sum = 0.0;
+  for (size_t i = N; i-- > 0;) sum = sum * y + c[i];
+  return sum;
+}
+
+// Optical polynomials in y = x - 1.82: CCM 1989 and O'Donnell 1994, the
+// coefficients as listed in docs/references.md.
+constexpr double kCcmA[] = {1.0,      0.17699, -0.50447, -0.02427,
+                            0.72085,  0.01979, -0.77530, 0.32999};
+constexpr double kCcmB[] = {0.0,     1.41338,  2.28305, 1.07233,
+                            -5.38434, -0.62251, 5.30260, -2.09002};
+constexpr double kODonnellA[] = {1.0,   0.104,  -0.609, 0.701, 1.137,
+                                 -1.718, -0.827, 1.647, -0.505};
+constexpr double kODonnellB[] = {0.0,    1.952, 2.908,   -3.989, -7.985,
+                                 11.102, 5.491, -10.805, 3.347};
+
+void check_R_V(double R_V) {
+  if (!(R_V >= kMinRV && R_V <= kMaxRV))
+    throw Error("R_V = " + number(R_V) + " is outside the extinction law's range [" +
+                number(kMinRV) + ", " + number(kMaxRV) + "]");
+}
+
+}  // namespace
+
+const char* to_string(ExtinctionLaw law) {
+  return law == ExtinctionLaw::CCM89 ? "CCM89" : "ODonnell94";
+}
+
+ExtinctionCoefficients extinction_coefficients(double x, ExtinctionLaw law) {
+  if (!(x >= kExtinctionMinInverseMicron && x <= kExtinctionMaxInverseMicron))
+    throw Error("wavelength " + number(1000.0 / x) + " nm (x = " + number(x) +
+                " 1/um) is outside the extinction law's range x in [" +
+                number(kExtinctionMinInverseMicron) + ", " +
+                number(kExtinctionMaxInverseMicron) + "] 1/um (" +
+                number(1000.0 / kExtinctionMaxInverseMicron) + " to " +
+                number(1000.0 / kExtinctionMinInverseMicron) + " nm)");
+  if (x < 1.1) {
+    const double power = std::pow(x, 1.61);  // CCM 1989 infrared power law
+    return {0.574 * power, -0.527 * power};
+  }
+  const double y = x - 1.82;
+  if (law == ExtinctionLaw::ODonnell94) return {polynomial(kODonnellA, y), polynomial(kODonnellB, y)};
+  return {polynomial(kCcmA, y), polynomial(kCcmB, y)};
+}
+
+double extinction_ratio_at(double wavelength_nm, double R_V, ExtinctionLaw law) {
+  check_R_V(R_V);
+  if (!(wavelength_nm > 0.0) || !std::isfinite(wavelength_nm))
+    throw Error("wavelength " + number(wavelength_nm) + " nm is not a positive finite number");
+  const ExtinctionCoefficients c = extinction_coefficients(1000.0 / wavelength_nm, law);
+  return c.a + c.b / R_V;
+}
+
+double band_extinction_ratio(const Passband& passband, double R_V, ExtinctionLaw law,
+                             const std::function<double(double)>* spectrum) {
+  check_R_V(R_V);
+  const auto source = [&](double lambda) { return spectrum ? (*spectrum)(lambda) : 1.0; };
+  const double weight = passband_integral(passband, source, kPassbandSubdivisions);
+  if (!(weight > 0.0))
+    throw Error("passband '" + passband.name + "': the weight integral of T S is " +
+                number(weight) + ", not positive");
+  const double extinction = passband_integral(
+      passband,
+      [&](double lambda) { return source(lambda) * extinction_ratio_at(lambda, R_V, law); },
+      kPassbandSubdivisions);
+  return extinction / weight;
+}
+
+BandRatios extinction_ratios(double R_V, ExtinctionLaw law, const Passband& B, const Passband& V,
+                             const Passband& R, const std::function<double(double)>* spectrum) {
+  const double v = band_extinction_ratio(V, R_V, law, spectrum);
+  return {band_extinction_ratio(B, R_V, law, spectrum) / v, 1.0,
+          band_extinction_ratio(R, R_V, law, spectrum) / v};
+}
+
+}  // namespace nebula

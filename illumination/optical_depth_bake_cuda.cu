@@ -1,0 +1,62 @@
+// CUDA launch of the per-star optical-depth bake; physics in the shared
+// NEBULA_HD star_to_voxel_depth.
+#include <cuda_runtime.h>
+
+#include "core/cuda_check.h"
+#include "illumination/optical_depth_bake.h"
+
+namespace nebula {
+namespace {
+
+__global__ void bake_kernel(DensityView grid, Vec3 star, float* depth) {
+  const GridShape& g = grid.shape;
+  const int x = blockIdx.x * blockDim.x + threadIdx.x;
+  const int y = blockIdx.y * blockDim.y + threadIdx.y;
+  const int z = blockIdx.z;
+  if (x >= g.nx || y >= g.ny) return;
+  depth[g.index(x, y, z)] = star_to_voxel_depth(grid, star, x, y, z);
+}
+
+}  // namespace
+
+BakeResult bake_star_depths_cuda(const DensityGrid& grid, const std::vector<Vec3>& stars) {
+  const GridShape& g = grid.shape;
+  const size_t bytes = g.count() * sizeof(float);
+  float *d_tau = nullptr, *d_depth = nullptr;
+  NEBULA_CUDA_CHECK(cudaMalloc(&d_tau, bytes));
+  NEBULA_CUDA_CHECK(cudaMalloc(&d_depth, bytes * stars.size()));
+  BakeResult out;
+  try {
+    NEBULA_CUDA_CHECK(cudaMemcpy(d_tau, grid.tau_v.data(), bytes, cudaMemcpyHostToDevice));
+    const DensityView view{g, d_tau};
+    const dim3 block(32, 8), blocks((g.nx + 31) / 32, (g.ny + 7) / 8, g.nz);
+    cudaEvent_t start, stop;
+    NEBULA_CUDA_CHECK(cudaEventCreate(&start));
+    NEBULA_CUDA_CHECK(cudaEventCreate(&stop));
+    NEBULA_CUDA_CHECK(cudaEventRecord(start));
+    for (size_t s = 0; s < stars.size(); ++s) {
+      bake_kernel<<<blocks, block>>>(view, stars[s], d_depth + s * g.count());
+      NEBULA_CUDA_CHECK(cudaGetLastError());
+    }
+    NEBULA_CUDA_CHECK(cudaEventRecord(stop));
+    NEBULA_CUDA_CHECK(cudaEventSynchronize(stop));
+    float ms = 0;
+    NEBULA_CUDA_CHECK(cudaEventElapsedTime(&ms, start, stop));
+    cudaEventDestroy(start);
+    cudaEventDestroy(stop);
+    out.seconds = ms * 1e-3;
+    out.tau_v.assign(stars.size(), std::vector<float>(g.count()));
+    for (size_t s = 0; s < stars.size(); ++s)
+      NEBULA_CUDA_CHECK(cudaMemcpy(out.tau_v[s].data(), d_depth + s * g.count(), bytes,
+                                   cudaMemcpyDeviceToHost));
+  } catch (...) {
+    cudaFree(d_tau);
+    cudaFree(d_depth);
+    throw;
+  }
+  cudaFree(d_tau);
+  cudaFree(d_depth);
+  return out;
+}
+
+}  // namespace nebula
