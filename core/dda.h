@@ -4,6 +4,7 @@
 // voxel the segment crosses, with the length inside it. No step size.
 #include <cfloat>
 #include <cmath>
+#include <type_traits>
 
 #include "core/grid.h"
 #include "core/hd.h"
@@ -19,6 +20,7 @@ NEBULA_HD float axis(const Vec3& v, int k) { return k == 0 ? v.x : (k == 1 ? v.y
 // crosses, in order, lengths in world units. The lengths telescope: they sum
 // to the length of the segment inside the grid to float rounding, whatever
 // rounding does at the boundaries. A segment outside the grid visits nothing.
+// A visitor returning bool stops the traversal by returning false.
 template <class Visit>
 NEBULA_HD void traverse_segment(const GridShape& g, Vec3 a, Vec3 b, Visit&& visit) {
   const Vec3 d = b - a;
@@ -75,7 +77,11 @@ NEBULA_HD void traverse_segment(const GridShape& g, Vec3 a, Vec3 b, Visit&& visi
   for (int guard = n[0] + n[1] + n[2] + 3; guard > 0; --guard) {
     const int k = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
     const float t_next = fminf(fmaxf(t_max[k], t), t1);
-    visit(g.index(cell[0], cell[1], cell[2]), t_next - t);
+    if constexpr (std::is_same_v<decltype(visit(size_t(0), 0.0f)), bool>) {
+      if (!visit(g.index(cell[0], cell[1], cell[2]), t_next - t)) return;
+    } else {
+      visit(g.index(cell[0], cell[1], cell[2]), t_next - t);
+    }
     t = t_next;
     if (t >= t1) return;
     cell[k] += step[k];

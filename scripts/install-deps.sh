@@ -6,6 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config
   libtbb-dev libhdf5-dev libcli11-dev libgtest-dev
+  libtomlplusplus-dev libcfitsio-dev libopenimageio-dev
   python3-numpy python3-matplotlib python3-h5py
 )
 

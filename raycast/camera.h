@@ -1,0 +1,66 @@
+#pragma once
+// Cameras: perspective, orthographic (the telescope view of a distant
+// observer) and the 180-degree fulldome fisheye (azimuthal equidistant dome
+// master). Pixel (0, 0) is the top-left corner of the image.
+#include <string>
+
+#include "core/hd.h"
+#include "core/math.h"
+#include "core/vec3.h"
+
+namespace nebula {
+
+enum class Projection : int { Perspective = 0, Orthographic = 1, Fisheye = 2 };
+
+struct Camera {
+  Projection projection = Projection::Perspective;
+  Vec3 position;
+  Vec3 forward, right, up;  // orthonormal; right x up = -forward is not assumed
+  int width = 0, height = 0;
+  float tan_half_fov = 0;   // perspective: vertical half-angle
+  float half_width = 0;     // orthographic: half extent in world units
+  float half_height = 0;
+
+  // The ray through the centre of pixel (px, py); false where the pixel shows
+  // nothing (outside the dome circle of the fisheye).
+  NEBULA_HD bool ray(int px, int py, Vec3& origin, Vec3& dir) const {
+    const float u = 2.0f * (px + 0.5f) / width - 1.0f;   // -1 left .. 1 right
+    const float v = 1.0f - 2.0f * (py + 0.5f) / height;  // 1 top .. -1 bottom
+    if (projection == Projection::Perspective) {
+      const float aspect = float(width) / float(height);
+      origin = position;
+      dir = normalize(forward + (u * aspect * tan_half_fov) * right + (v * tan_half_fov) * up);
+      return true;
+    }
+    if (projection == Projection::Orthographic) {
+      origin = position + (u * half_width) * right + (v * half_height) * up;
+      dir = forward;
+      return true;
+    }
+    // Azimuthal equidistant: the distance from the centre is proportional to
+    // the angle from the zenith (forward), 90 degrees at the rim.
+    const float rho = sqrtf(u * u + v * v);
+    if (rho > 1.0f) return false;
+    const float theta = rho * 0.5f * kPi;
+    const float cos_phi = rho > 0.0f ? u / rho : 1.0f, sin_phi = rho > 0.0f ? v / rho : 0.0f;
+    origin = position;
+    dir = normalize(cosf(theta) * forward + (sinf(theta) * cos_phi) * right +
+                    (sinf(theta) * sin_phi) * up);
+    return true;
+  }
+};
+
+struct CameraSettings {
+  Projection projection = Projection::Perspective;
+  Vec3 position{0, 0, -10}, look_at{0, 0, 0}, up{0, 1, 0};
+  double fov_deg = 40;      // perspective, vertical
+  double ortho_width = 0;   // orthographic: world units across the image
+  int width = 512, height = 512;
+};
+
+// Builds the camera; throws Error naming the setting when it is degenerate.
+Camera make_camera(const CameraSettings& s);
+
+const char* to_string(Projection p);
+
+}  // namespace nebula

@@ -1,0 +1,80 @@
+#include "raycast/renderer.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <chrono>
+
+#include "core/error.h"
+
+namespace nebula {
+
+void validate(const RenderInputs& in) {
+  if (!in.density) throw Error("render: no density grid");
+  const size_t voxels = in.density->shape.count();
+  if (in.density->tau_v.size() != voxels) throw Error("render: density has the wrong number of voxels");
+  if (in.bands.empty() || in.bands.size() > size_t(kMaxBands))
+    throw Error("render: 1 to " + std::to_string(kMaxBands) + " bands required");
+  for (const RenderBand& b : in.bands) {
+    if (b.albedo > 0 && !b.table) throw Error("render: band " + b.name + " scatters but has no table");
+    if (b.emission && b.emission->size() != voxels)
+      throw Error("render: emission of band " + b.name + " does not match the density grid");
+  }
+  for (const RenderStar& s : in.stars) {
+    if (s.power.size() != in.bands.size()) throw Error("render: a star lacks band powers");
+    if (!s.depth_v || s.depth_v->size() != voxels) throw Error("render: a star has no baked depth");
+  }
+}
+
+Image render_cpu(const RenderInputs& in, RenderStats* stats) {
+  validate(in);
+  MarchScene scene{};
+  scene.density = in.density->view();
+  scene.n_bands = static_cast<int>(in.bands.size());
+  scene.min_transmittance = in.min_transmittance;
+  for (int b = 0; b < scene.n_bands; ++b) {
+    const RenderBand& band = in.bands[b];
+    scene.extinction_ratio[b] = band.extinction_ratio;
+    scene.albedo[b] = band.albedo;
+    scene.table[b] = band.table ? view_of(*band.table) : TableView{};
+    scene.emission[b] = band.emission ? band.emission->data() : nullptr;
+  }
+  std::vector<StarView> stars(in.stars.size());
+  for (size_t k = 0; k < stars.size(); ++k) {
+    stars[k].position = in.stars[k].position;
+    for (int b = 0; b < scene.n_bands; ++b) stars[k].power[b] = in.stars[k].power[b];
+    stars[k].depth_v = in.stars[k].depth_v->data();
+  }
+  scene.stars = stars.data();
+  scene.n_stars = static_cast<int>(stars.size());
+
+  std::vector<std::string> names;
+  for (const RenderBand& b : in.bands) names.push_back(b.name);
+  Image image(in.camera.width, in.camera.height, names);
+  std::atomic<uint64_t> clamps{0};
+  const auto start = std::chrono::steady_clock::now();
+  tbb::parallel_for(tbb::blocked_range<int>(0, in.camera.height), [&](const auto& rows) {
+    uint64_t local_clamps = 0;
+    for (int y = rows.begin(); y != rows.end(); ++y)
+      for (int x = 0; x < in.camera.width; ++x) {
+        Vec3 origin, dir;
+        if (!in.camera.ray(x, y, origin, dir)) continue;
+        const RayResult r = march_ray(scene, origin, dir);
+        for (int b = 0; b < scene.n_bands; ++b) image.at(b, x, y) = in.exposure * r.radiance[b];
+        local_clamps += r.table_clamps;
+      }
+    clamps += local_clamps;
+  });
+  if (stats) {
+    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats->table_clamps = clamps;
+  }
+  return image;
+}
+
+Image render(const RenderInputs& in, Backend backend, RenderStats* stats) {
+  return backend == Backend::Cuda ? render_cuda(in, stats) : render_cpu(in, stats);
+}
+
+}  // namespace nebula

@@ -1,0 +1,59 @@
+#pragma once
+// Scenes for the renderer's tests: analytic tables and simple grids.
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "core/grid.h"
+#include "illumination/optical_depth_bake.h"
+#include "montecarlo/henyey_greenstein.h"
+#include "raycast/renderer.h"
+#include "tables/scattering_table.h"
+
+namespace nebula::testing {
+
+// The optically thin table P = tau_sct x (bin mean of p_HG): exact for g = 0.
+inline ScatteringTable thin_table(double g, int n_mu = 180, double tau_max = 2.0) {
+  ScatteringTable t = ScatteringTable::make_axes(tau_max, 3, AngularBinning::UniformTheta, n_mu);
+  t.g = g;
+  const AngularBins bins = t.bins();
+  for (int i = 0; i < t.n_tau(); ++i)
+    for (int k = 0; k < n_mu; ++k)
+      t.P[t.index(i, k)] = static_cast<float>(t.tau[i] * hg_bin_mean(g, bins.edge(k), bins.edge(k + 1)));
+  return t;
+}
+
+// A cube of n^3 voxels spanning [-half, half]^3.
+inline DensityGrid cube(int n, float half, float tau_v = 0.0f) {
+  DensityGrid g;
+  g.shape.nx = g.shape.ny = g.shape.nz = n;
+  g.shape.voxel = 2 * half / n;
+  g.shape.origin = {-half, -half, -half};
+  g.tau_v.assign(g.shape.count(), tau_v);
+  return g;
+}
+
+// Fills the voxels whose centre lies within `radius` of the origin.
+inline void fill_sphere(DensityGrid& g, float radius, float tau_v) {
+  for (int z = 0; z < g.shape.nz; ++z)
+    for (int y = 0; y < g.shape.ny; ++y)
+      for (int x = 0; x < g.shape.nx; ++x)
+        if (length(g.shape.centre(x, y, z)) <= radius) g.tau_v[g.shape.index(x, y, z)] = tau_v;
+}
+
+// One band, one star: everything render() needs, owning the pieces.
+struct OneStarScene {
+  DensityGrid grid;
+  ScatteringTable table;
+  std::vector<float> depth;
+  RenderInputs inputs;
+  void finish(Vec3 star, float power, float albedo, const Camera& camera) {
+    depth = bake_star_depths_cpu(grid, {star}).tau_v[0];
+    inputs.density = &grid;
+    inputs.bands = {RenderBand{"V", 1.0f, albedo, &table, nullptr}};
+    inputs.stars = {RenderStar{star, {power}, &depth}};
+    inputs.camera = camera;
+  }
+};
+
+}  // namespace nebula::testing
