@@ -4,6 +4,6 @@
 # libraries). Build first: cmake -S . -B build -DNEBULA_CUDA=ON && cmake --build build
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bins=(build/bin/nebula build/bin/core_tests build/bin/montecarlo_tests build/bin/tables_tests build/bin/illumination_tests)
+bins=(build/bin/nebula build/bin/core_tests build/bin/montecarlo_tests build/bin/tables_tests build/bin/illumination_tests build/bin/raycast_tests)
 bins+=(build/bin/*_gpu_tests)
 ../shared/tools/device-bundle .devbundle "${bins[@]}"

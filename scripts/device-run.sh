@@ -11,10 +11,11 @@ mkdir -p "$OUT"
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm,memory.total --format=csv | tee "$OUT/gpu.txt"
 {
   for t in "$B"/bin/*_gpu_tests; do "$t" --gtest_brief=1 || echo "FAILED: $t"; done
-  for t in core_tests montecarlo_tests tables_tests illumination_tests; do "$B/bin/$t" --gtest_brief=1 || echo "FAILED: $t"; done
+  for t in core_tests montecarlo_tests tables_tests illumination_tests raycast_tests; do "$B/bin/$t" --gtest_brief=1 || echo "FAILED: $t"; done
 } 2>&1 | tee "$OUT/tests.log"
 "$B/bin/nebula" validate montecarlo --backend cuda --effort 4 2>&1 | tee "$OUT/validate.log"
 "$B/bin/nebula" tabulate --backend cuda -q --photons 1e6 -o "$OUT/table_a0.6_g0.6.h5" 2>&1 | tee "$OUT/tabulate.log"
 "$B/bin/nebula" tabulate --backend cuda -q --photons 1e6 --illumination pencil -o "$OUT/table_pencil.h5" 2>&1 | tail -3
 "$B/bin/nebula" bench tabulate --backend both --repeats 5 2>&1 | tee "$OUT/bench.log"
 "$B/bin/nebula" bench bake --backend both --size 256 --stars 4 2>&1 | tee "$OUT/bench_bake.log"
+"$B/bin/nebula" bench render --backend both --size 256 --stars 8 2>&1 | tee "$OUT/bench_render.log"

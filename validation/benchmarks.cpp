@@ -5,6 +5,8 @@
 
 #include "core/philox.h"
 #include "illumination/optical_depth_bake.h"
+#include "raycast/renderer.h"
+#include "tables/scattering_table.h"
 
 namespace nebula {
 namespace {
@@ -102,6 +104,66 @@ BakeBenchResult bench_bake(Backend backend, int size, int stars, int repeats) {
   r.median_seconds = median_of(times);
   r.voxels_per_second = double(grid.shape.count()) * stars / r.median_seconds;
   return r;
+}
+
+std::vector<RenderBenchRow> bench_render(Backend backend, int size, int width, int height, int max_stars,
+                                         int repeats) {
+  DensityGrid grid;
+  grid.shape.nx = grid.shape.ny = grid.shape.nz = size;
+  grid.shape.voxel = 2.0f / size;
+  grid.shape.origin = {-1, -1, -1};
+  grid.tau_v.resize(grid.shape.count());
+  for (int z = 0; z < size; ++z)
+    for (int y = 0; y < size; ++y)
+      for (int x = 0; x < size; ++x) {
+        const size_t c = grid.shape.index(x, y, z);
+        const float r = length(grid.shape.centre(x, y, z));
+        grid.tau_v[c] = r < 0.95f ? 0.5f * philox_uniform4(41, 0, uint32_t(c), 0, 0).u0 : 0.0f;
+      }
+  TabulateParams tp;
+  tp.photons_per_row = 10000;
+  tp.binning = AngularBinning::UniformTheta;
+  const Tabulation tab = tabulate(tp, backend);
+  ScatteringTable table = ScatteringTable::make_axes(tp.tau_max, tp.tau_bins, tp.binning, tp.mu_bins);
+  for (size_t e = 0; e < tab.P.size(); ++e) table.P[e] = static_cast<float>(tab.P[e]);
+
+  CameraSettings cs;
+  cs.position = {0.4f, -3.2f, 1.1f};
+  cs.look_at = {0, 0, 0};
+  cs.up = {0, 0, 1};
+  cs.fov_deg = 45;
+  cs.width = width;
+  cs.height = height;
+  std::vector<RenderBenchRow> rows;
+  for (int stars = 1; stars <= max_stars; stars *= 2) {
+    std::vector<Vec3> positions;
+    for (int k = 0; k < stars; ++k)
+      positions.push_back({0.5f * std::cos(1.3f * k), 0.5f * std::sin(1.3f * k), 0.2f * k - 0.4f});
+    const BakeResult bake = bake_star_depths(grid, positions, backend);
+    RenderInputs in;
+    in.density = &grid;
+    const float ratios[3] = {1.2f, 1.0f, 0.85f};
+    for (int b = 0; b < 3; ++b) in.bands.push_back(RenderBand{std::string(1, "BVR"[b]), ratios[b], 0.6f, &table, nullptr});
+    for (int k = 0; k < stars; ++k) in.stars.push_back(RenderStar{positions[k], {1e3f, 1e3f, 1e3f}, &bake.tau_v[k]});
+    in.camera = make_camera(cs);
+    RenderStats stats;
+    render(in, backend, &stats);  // warm-up
+    std::vector<double> times;
+    for (int i = 0; i < repeats; ++i) {
+      render(in, backend, &stats);
+      times.push_back(stats.seconds);
+    }
+    RenderBenchRow row;
+    row.backend = to_string(backend);
+    row.width = width;
+    row.height = height;
+    row.size = size;
+    row.stars = stars;
+    row.median_seconds = median_of(times);
+    row.rays_per_second = double(width) * height / row.median_seconds;
+    rows.push_back(row);
+  }
+  return rows;
 }
 
 }  // namespace nebula

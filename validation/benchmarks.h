@@ -48,3 +48,20 @@ struct BakeBenchResult {
 BakeBenchResult bench_bake(Backend backend, int size, int stars, int repeats);
 
 }  // namespace nebula
+
+namespace nebula {
+
+struct RenderBenchRow {
+  std::string backend;
+  int width = 0, height = 0, size = 0, stars = 0;
+  double median_seconds = 0;  // marching only (CUDA events on the GPU)
+  double rays_per_second = 0;
+};
+
+// Frames of a size^3 noisy dust ball (tau_v up to 0.5 per voxel) lit by 1, 2,
+// 4, ... `max_stars` stars, seen from outside with a perspective camera, with
+// a table tabulated on the same backend (a = g = 0.6, 10^4 photons per row).
+std::vector<RenderBenchRow> bench_render(Backend backend, int size, int width, int height, int max_stars,
+                                         int repeats);
+
+}  // namespace nebula
