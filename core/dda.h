@@ -21,25 +21,20 @@ NEBULA_HD float axis(const Vec3& v, int k) { return k == 0 ? v.x : (k == 1 ? v.y
 // to the length of the segment inside the grid to float rounding, whatever
 // rounding does at the boundaries. A segment outside the grid visits nothing.
 // A visitor returning bool stops the traversal by returning false.
-template <class Visit>
-NEBULA_HD void traverse_segment(const GridShape& g, Vec3 a, Vec3 b, Visit&& visit) {
-  const Vec3 d = b - a;
-  const float len = length(d);
-  if (!(len > 0.0f)) return;
-  const Vec3 dir = (1.0f / len) * d;
+// Clips the ray a + t dir (unit dir), 0 <= t <= len, to the grid box:
+// false when it misses, else the parameter range [t0, t1] inside.
+NEBULA_HD bool clip_to_grid(const GridShape& g, Vec3 a, Vec3 dir, float len, float& t0, float& t1) {
   const int n[3] = {g.nx, g.ny, g.nz};
-  float t0 = 0.0f, t1 = len;
-  float inv[3];
+  t0 = 0.0f;
+  t1 = len;
   for (int k = 0; k < 3; ++k) {
     const float lo = detail::axis(g.origin, k), hi = lo + g.voxel * n[k];
     const float ak = detail::axis(a, k), dk = detail::axis(dir, k);
     if (dk == 0.0f) {
-      inv[k] = FLT_MAX;
-      if (ak < lo || ak > hi) return;
+      if (ak < lo || ak > hi) return false;
       continue;
     }
-    inv[k] = 1.0f / dk;
-    float ta = (lo - ak) * inv[k], tb = (hi - ak) * inv[k];
+    float ta = (lo - ak) / dk, tb = (hi - ak) / dk;
     if (ta > tb) {
       const float s = ta;
       ta = tb;
@@ -48,7 +43,23 @@ NEBULA_HD void traverse_segment(const GridShape& g, Vec3 a, Vec3 b, Visit&& visi
     t0 = fmaxf(t0, ta);
     t1 = fminf(t1, tb);
   }
-  if (!(t0 < t1)) return;
+  return t0 < t1;
+}
+
+template <class Visit>
+NEBULA_HD void traverse_segment(const GridShape& g, Vec3 a, Vec3 b, Visit&& visit) {
+  const Vec3 d = b - a;
+  const float len = length(d);
+  if (!(len > 0.0f)) return;
+  const Vec3 dir = (1.0f / len) * d;
+  const int n[3] = {g.nx, g.ny, g.nz};
+  float t0, t1;
+  if (!clip_to_grid(g, a, dir, len, t0, t1)) return;
+  float inv[3];
+  for (int k = 0; k < 3; ++k) {
+    const float dk = detail::axis(dir, k);
+    inv[k] = dk == 0.0f ? FLT_MAX : 1.0f / dk;
+  }
   // The voxel holding the midpoint of the first crossing step's start.
   int cell[3], step[3];
   float t_max[3], t_delta[3];

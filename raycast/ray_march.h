@@ -42,8 +42,80 @@ struct RayResult {
   int table_clamps;
 };
 
-// Marches from `origin` along unit `dir` through the whole grid.
-NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir) {
+// Light that dust at `pos` (V-band depth per voxel edge tau_v) sends towards
+// the eye per band, per unit of chord / l: sum over stars of E_s P(tau_sct,
+// theta_s). depth_of(k) is star k's baked V-band depth to this point.
+template <class DepthOf>
+NEBULA_HD void scattered_source(const MarchScene& s, Vec3 pos, float tau_v, Vec3 to_eye,
+                                DepthOf&& depth_of, float* source, int* clamps) {
+  if (!(tau_v > 0.0f)) return;
+  for (int k = 0; k < s.n_stars; ++k) {
+    const StarView& star = s.stars[k];
+    const Vec3 d = pos - star.position;
+    const float r = length(d);
+    // theta: between the light's direction (star to dust) and the way to the eye.
+    const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
+    const float depth = depth_of(k);
+    for (int b = 0; b < s.n_bands; ++b) {
+      if (!(s.albedo[b] > 0.0f)) continue;
+      const float tau_b = tau_v * s.extinction_ratio[b];
+      const float e = star_irradiance(star.power[b], r, s.density.shape.voxel, depth * s.extinction_ratio[b]);
+      source[b] += e * s.table[b].lookup(s.albedo[b] * tau_b, mu, clamps);
+    }
+  }
+}
+
+NEBULA_HD Vec3 voxel_centre(const GridShape& g, size_t cell) {
+  const int x = static_cast<int>(cell % g.nx);
+  const int y = static_cast<int>((cell / g.nx) % g.ny);
+  const int z = static_cast<int>(cell / (size_t(g.nx) * g.ny));
+  return g.centre(x, y, z);
+}
+
+// A cell-centred field at `pos`: trilinear (clamped at the grid's edge) or
+// the value of the voxel holding pos.
+NEBULA_HD float sample_field(const GridShape& g, const float* f, Vec3 pos, bool trilinear) {
+  const float u[3] = {(pos.x - g.origin.x) / g.voxel, (pos.y - g.origin.y) / g.voxel,
+                      (pos.z - g.origin.z) / g.voxel};
+  const int n[3] = {g.nx, g.ny, g.nz};
+  if (!trilinear) {
+    int c[3];
+    for (int k = 0; k < 3; ++k) {
+      c[k] = static_cast<int>(floorf(u[k]));
+      c[k] = c[k] < 0 ? 0 : (c[k] >= n[k] ? n[k] - 1 : c[k]);
+    }
+    return f[g.index(c[0], c[1], c[2])];
+  }
+  int i0[3], i1[3];
+  float w[3];
+  for (int k = 0; k < 3; ++k) {
+    const float x = clamp(u[k] - 0.5f, 0.0f, float(n[k] - 1));
+    i0[k] = static_cast<int>(x);
+    i1[k] = i0[k] + 1 < n[k] ? i0[k] + 1 : i0[k];
+    w[k] = x - i0[k];
+  }
+  float v = 0.0f;
+  for (int corner = 0; corner < 8; ++corner) {
+    const int x = corner & 1 ? i1[0] : i0[0], y = corner & 2 ? i1[1] : i0[1], z = corner & 4 ? i1[2] : i0[2];
+    const float weight = (corner & 1 ? w[0] : 1 - w[0]) * (corner & 2 ? w[1] : 1 - w[1]) * (corner & 4 ? w[2] : 1 - w[2]);
+    v += weight * f[g.index(x, y, z)];
+  }
+  return v;
+}
+
+// How a ray gathers light: the exact traversal (the reference), or the smooth
+// display mode sampling the fields at a fixed step (in voxels) along the ray.
+struct MarchMode {
+  float step_voxels = 0.0f;  // 0: exact traversal
+  bool trilinear = true;     // smooth mode: trilinear fields, else the voxel's value
+};
+
+// Marches from `origin` along unit `dir` through the whole grid. In both
+// modes a voxel's dust is seen through the transmittance to where the ray
+// enters that voxel (DESIGN.md: P holds the voxel's own extinction, so a
+// sub-voxel step must not darken its voxel again); the smooth mode spreads
+// the voxel's chord over samples of the interpolated fields inside it.
+NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchMode mode = {}) {
   RayResult out{};
   for (int b = 0; b < kMaxBands; ++b) out.transmittance[b] = 1.0f;
   const GridShape& g = s.density.shape;
@@ -51,32 +123,41 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir) {
   const Vec3 span = g.upper() - g.origin;
   const Vec3 mid = g.origin + 0.5f * span;
   const float far = length(origin - mid) + length(span) + g.voxel;
+  float t_enter = 0.0f, t_exit = 0.0f;
+  if (!clip_to_grid(g, origin, dir, far, t_enter, t_exit)) return out;
   const float inv_voxel = 1.0f / g.voxel;
+  const float step = mode.step_voxels * g.voxel;
   const Vec3 to_eye = -dir;
+  float t = t_enter;  // where the current voxel begins along the ray
   traverse_segment(g, origin, origin + far * dir, [&](size_t cell, float chord) -> bool {
     const float tau_v = s.density.tau_v[cell];
-    float source[kMaxBands];
-    for (int b = 0; b < s.n_bands; ++b) source[b] = s.emission[b] ? s.emission[b][cell] : 0.0f;
-    if (tau_v > 0.0f && s.n_stars > 0) {
-      const int x = static_cast<int>(cell % g.nx);
-      const int y = static_cast<int>((cell / g.nx) % g.ny);
-      const int z = static_cast<int>(cell / (size_t(g.nx) * g.ny));
-      const Vec3 centre = g.centre(x, y, z);
-      for (int k = 0; k < s.n_stars; ++k) {
-        const StarView& star = s.stars[k];
-        const Vec3 d = centre - star.position;
-        const float r = length(d);
-        // theta: between the light's direction (star to voxel) and the way to the eye.
-        const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
-        const float depth = star.depth_v[cell];
-        for (int b = 0; b < s.n_bands; ++b) {
-          if (!(s.albedo[b] > 0.0f)) continue;
-          const float tau_b = tau_v * s.extinction_ratio[b];
-          const float e = star_irradiance(star.power[b], r, g.voxel, depth * s.extinction_ratio[b]);
-          source[b] += e * s.table[b].lookup(s.albedo[b] * tau_b, mu, &out.table_clamps);
-        }
+    float source[kMaxBands] = {};
+    if (step > 0.0f) {
+      // Samples at t_enter + (k + 1/2) step that fall inside this voxel.
+      const float first = ceilf((t - t_enter) / step - 0.5f);
+      for (float k = fmaxf(first, 0.0f);; k += 1.0f) {
+        const float ts = t_enter + (k + 0.5f) * step;
+        if (ts >= t + chord || ts >= t_exit) break;
+        // Trilinear fields are smooth, so is their geometry; voxel values keep
+        // the voxel centre's, as the exact traversal does.
+        const Vec3 pos = mode.trilinear ? origin + ts * dir : voxel_centre(g, cell);
+        float local[kMaxBands] = {};
+        for (int b = 0; b < s.n_bands; ++b)
+          local[b] = s.emission[b] ? sample_field(g, s.emission[b], pos, mode.trilinear) : 0.0f;
+        scattered_source(s, pos, sample_field(g, s.density.tau_v, pos, mode.trilinear), to_eye,
+                         [&](int k_star) { return sample_field(g, s.stars[k_star].depth_v, pos, mode.trilinear); },
+                         local, &out.table_clamps);
+        for (int b = 0; b < s.n_bands; ++b) source[b] += local[b] * step / fmaxf(chord, 1e-30f);
+      }
+    } else {
+      for (int b = 0; b < s.n_bands; ++b) source[b] = s.emission[b] ? s.emission[b][cell] : 0.0f;
+      if (tau_v > 0.0f && s.n_stars > 0) {
+        scattered_source(s, voxel_centre(g, cell), tau_v, to_eye,
+                         [&](int k_star) { return s.stars[k_star].depth_v[cell]; }, source,
+                         &out.table_clamps);
       }
     }
+    t += chord;
     const float fraction = chord * inv_voxel;
     bool visible = false;
     for (int b = 0; b < s.n_bands; ++b) {

@@ -14,6 +14,8 @@ void validate(const RenderInputs& in) {
   if (!in.density) throw Error("render: no density grid");
   const size_t voxels = in.density->shape.count();
   if (in.density->tau_v.size() != voxels) throw Error("render: density has the wrong number of voxels");
+  if (!(in.mode.step_voxels >= 0.0f) || (in.mode.step_voxels > 0 && in.mode.step_voxels < 1e-3f))
+    throw Error("render: the smooth mode's step must be 0 (exact) or at least 1e-3 voxels");
   if (in.bands.empty() || in.bands.size() > size_t(kMaxBands))
     throw Error("render: 1 to " + std::to_string(kMaxBands) + " bands required");
   for (const RenderBand& b : in.bands) {
@@ -60,7 +62,7 @@ Image render_cpu(const RenderInputs& in, RenderStats* stats) {
       for (int x = 0; x < in.camera.width; ++x) {
         Vec3 origin, dir;
         if (!in.camera.ray(x, y, origin, dir)) continue;
-        const RayResult r = march_ray(scene, origin, dir);
+        const RayResult r = march_ray(scene, origin, dir, in.mode);
         for (int b = 0; b < scene.n_bands; ++b) image.at(b, x, y) = in.exposure * r.radiance[b];
         local_clamps += r.table_clamps;
       }

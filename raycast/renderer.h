@@ -34,6 +34,7 @@ struct RenderInputs {
   Camera camera;
   float exposure = 1.0f;
   float min_transmittance = 1e-4f;
+  MarchMode mode;  // exact traversal by default; step_voxels > 0: smooth display mode
 };
 
 struct RenderStats {

@@ -35,14 +35,14 @@ class DeviceArray {
   size_t size_ = 0;
 };
 
-__global__ void render_kernel(MarchScene scene, Camera camera, float exposure, float* pixels,
-                              unsigned long long* clamps) {
+__global__ void render_kernel(MarchScene scene, Camera camera, MarchMode mode, float exposure,
+                              float* pixels, unsigned long long* clamps) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x;
   const int y = blockIdx.y * blockDim.y + threadIdx.y;
   if (x >= camera.width || y >= camera.height) return;
   Vec3 origin, dir;
   if (!camera.ray(x, y, origin, dir)) return;
-  const RayResult r = march_ray(scene, origin, dir);
+  const RayResult r = march_ray(scene, origin, dir, mode);
   const size_t plane = size_t(camera.width) * camera.height;
   for (int b = 0; b < scene.n_bands; ++b) pixels[b * plane + size_t(y) * camera.width + x] = exposure * r.radiance[b];
   if (r.table_clamps) atomicAdd(clamps, static_cast<unsigned long long>(r.table_clamps));
@@ -95,7 +95,7 @@ Image render_cuda(const RenderInputs& in, RenderStats* stats) {
   NEBULA_CUDA_CHECK(cudaEventCreate(&start));
   NEBULA_CUDA_CHECK(cudaEventCreate(&stop));
   NEBULA_CUDA_CHECK(cudaEventRecord(start));
-  render_kernel<<<grid, block>>>(scene, in.camera, in.exposure, pixels.get(), clamps.get());
+  render_kernel<<<grid, block>>>(scene, in.camera, in.mode, in.exposure, pixels.get(), clamps.get());
   NEBULA_CUDA_CHECK(cudaGetLastError());
   NEBULA_CUDA_CHECK(cudaEventRecord(stop));
   NEBULA_CUDA_CHECK(cudaEventSynchronize(stop));

@@ -28,18 +28,22 @@ TEST(RendererGpu, AgreesWithTheCpu) {
   cs.width = 96;
   cs.height = 64;
   s.finish({0.1f, 0.2f, -0.1f}, 100.0f, 0.6f, make_camera(cs));
-  RenderStats cpu_stats, gpu_stats;
-  const Image cpu = render_cpu(s.inputs, &cpu_stats);
-  const Image gpu = render_cuda(s.inputs, &gpu_stats);
-  double peak = 0, worst = 0;
-  for (size_t i = 0; i < cpu.pixels.size(); ++i) {
-    peak = std::max(peak, double(cpu.pixels[i]));
-    worst = std::max(worst, double(std::fabs(cpu.pixels[i] - gpu.pixels[i])));
+  for (MarchMode mode : {MarchMode{}, MarchMode{0.25f, true}}) {
+    s.inputs.mode = mode;
+    RenderStats cpu_stats, gpu_stats;
+    const Image cpu = render_cpu(s.inputs, &cpu_stats);
+    const Image gpu = render_cuda(s.inputs, &gpu_stats);
+    double peak = 0, worst = 0;
+    for (size_t i = 0; i < cpu.pixels.size(); ++i) {
+      peak = std::max(peak, double(cpu.pixels[i]));
+      worst = std::max(worst, double(std::fabs(cpu.pixels[i] - gpu.pixels[i])));
+    }
+    std::printf("%s: largest CPU-GPU difference %.3g of the peak %.3g\n",
+                mode.step_voxels > 0 ? "smooth" : "exact", worst / peak, peak);
+    EXPECT_GT(peak, 0.0);
+    EXPECT_LT(worst, 1e-4 * peak);
+    EXPECT_EQ(cpu_stats.table_clamps, gpu_stats.table_clamps);
   }
-  std::printf("largest CPU-GPU difference %.3g of the peak %.3g\n", worst / peak, peak);
-  EXPECT_GT(peak, 0.0);
-  EXPECT_LT(worst, 1e-4 * peak);
-  EXPECT_EQ(cpu_stats.table_clamps, gpu_stats.table_clamps);
 }
 
 }  // namespace
