@@ -43,6 +43,27 @@ expect_failure(missing_table "missing.h5" table info missing.h5)
 file(WRITE ${WORK}/text.h5 "not a table\n")
 expect_failure(text_table "text.h5" table info text.h5)
 
+# Rendering: bad requests fail before any work, with one line.
+set(ENV{NEBULA_CACHE_DIR} ${WORK}/cache)
+expect_failure(render_nothing "--demo" render -o bad.png)
+expect_failure(render_demo_set "--set" render --demo --set camera.fov_deg=30 -o bad.png)
+expect_failure(render_extension "unknown image format" render --demo -o bad.jpg)
+file(WRITE ${WORK}/scene_with_typo.toml
+     "[density]\nprocedural = { n = 8 }\n[[stars]]\nluminosity_lsun = 1.0\nclass = \"G2V\"\n[camera]\nzoom = 3\n")
+expect_failure(render_unknown_key "camera.zoom" render scene_with_typo.toml -o bad.h5)
+expect_failure(render_missing_scene "missing.toml" render missing.toml -o bad.h5)
+# A small real render (tables generated into the scratch cache).
+execute_process(COMMAND ${NEBULA} render ${SOURCE}/scenes/uniform_sphere.toml --width 24 --height 24
+                        --table-photons 2000 --backend cpu -q -o sphere.h5
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err WORKING_DIRECTORY ${WORK})
+if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/sphere.h5)
+  message(FATAL_ERROR "render failed (${rc}): ${out} ${err}")
+endif()
+string(FIND "${out}" "computed, and why" at)
+if(at EQUAL -1)
+  message(FATAL_ERROR "render printed no account of what it computed: ${out}")
+endif()
+
 # A good run, then the overwrite rule.
 execute_process(COMMAND ${NEBULA} tabulate ${small} -o good.h5 RESULT_VARIABLE rc OUTPUT_VARIABLE out
                 WORKING_DIRECTORY ${WORK})

@@ -9,5 +9,6 @@ void add_table_command(CLI::App& app);
 void add_slab_command(CLI::App& app);
 void add_validate_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_render_command(CLI::App& app);
 
 }  // namespace nebula::app

@@ -9,9 +9,10 @@
 int main(int argc, char** argv) {
   CLI::App app{
       "nebula: physics simulator and renderer for reflection nebulae.\n"
-      "Start with `nebula tabulate -o table.h5` (the multiple-scattering table of one voxel)."};
+      "Start with `nebula render --demo -o demo.png`, or `nebula tabulate -o table.h5`."};
   app.require_subcommand(1);
   app.set_version_flag("--version", "nebula 0.1.0");
+  nebula::app::add_render_command(app);
   nebula::app::add_tabulate_command(app);
   nebula::app::add_table_command(app);
   nebula::app::add_slab_command(app);

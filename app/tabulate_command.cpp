@@ -7,6 +7,7 @@
 
 #include "app/commands.h"
 #include "app/output_path.h"
+#include "app/table_conversion.h"
 #include "core/error.h"
 #include "core/math.h"
 #include "core/progress.h"
@@ -16,33 +17,6 @@
 
 namespace nebula::app {
 namespace {
-
-constexpr const char* kGenerator = "nebula 0.1.0";
-
-ScatteringTable to_table(const Tabulation& t) {
-  const TabulateParams& p = t.params;
-  ScatteringTable table = ScatteringTable::make_axes(p.tau_max, p.tau_bins, p.binning, p.mu_bins);
-  table.albedo = p.albedo;
-  table.g = p.g;
-  table.illumination = to_string(p.beam);
-  table.photons_per_row = p.photons_per_row;
-  table.seed = p.seed;
-  table.generator = kGenerator;
-  table.forced_first_scattering = p.forced_first_scattering;
-  table.roulette_threshold = p.roulette.threshold;
-  table.roulette_survival = p.roulette.survival;
-  table.max_orders = p.roulette.max_orders;
-  table.capped_photons = t.capped_photons;
-  table.scattering_events = t.scattering_events;
-  for (size_t e = 0; e < t.P.size(); ++e) {
-    table.P[e] = static_cast<float>(t.P[e]);
-    table.P_stderr[e] = static_cast<float>(t.P_stderr[e]);
-  }
-  table.total = t.total;
-  table.total_stderr = t.total_stderr;
-  table.unscattered = t.unscattered;
-  return table;
-}
 
 // The entry with the largest relative standard error among entries holding
 // at least 1% of their row's peak (the rest are dominated by empty bins).

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # The main job on the built-in default: installs what is missing, builds, and
-# tabulates the standard multiple-scattering table (a = 0.6, g = 0.6, 1000 tau
-# x 72 mu bins) into out/table_a0.6_g0.6.h5, printing its summary. Uses the GPU
-# when one is present. Extra arguments go to `nebula tabulate`.
+# renders the built-in demo nebula (procedural dust, an O5V star; a = g = 0.6,
+# R_V = 5) to out/demo.png, printing what was computed and why. The first run
+# also tabulates and caches the scattering table (half a minute on two CPU
+# cores). Uses the GPU when one is present. Extra arguments go to
+# `nebula render`, e.g. --width 1024 --height 1024.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -14,4 +16,4 @@ if ! cmake --build build -j"$(nproc)" >build/build.log 2>&1; then
   exit 1
 fi
 mkdir -p out
-build/bin/nebula tabulate --albedo 0.6 --g 0.6 --force -o out/table_a0.6_g0.6.h5 "$@"
+build/bin/nebula render --demo --force -o out/demo.png "$@"

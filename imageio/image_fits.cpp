@@ -1,0 +1,313 @@
+// The FITS image file: one 3-D primary image, NAXIS1 = width, NAXIS2 =
+// height, NAXIS3 = bands, BITPIX -32. FITS rows run bottom-up (pixel (1, 1)
+// is the lower left corner as FITS viewers show it), so row y of an Image is
+// FITS row NAXIS2 - y on both write and read. Keywords: BUNIT, BAND1..n,
+// EXPOSURE, one keyword per metadata entry, CHECKSUM and DATASUM
+// (imageio/README.md).
+#include <fitsio.h>
+
+#include <algorithm>
+#include <cctype>
+#include <climits>
+#include <cmath>
+#include <filesystem>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "imageio/image_formats.h"
+
+namespace nebula::imageio_detail {
+
+namespace {
+
+// cfitsio is thread-safe only when built reentrant (Debian's is); images are
+// written rarely, so one lock costs nothing and spares us the question.
+std::mutex fits_mutex;
+
+// The comment that marks a keyword as a metadata entry and keeps the key's
+// case, which FITS keywords (upper case) lose.
+const std::string kEntryMarker = "nebula key: ";
+
+std::string cfitsio_reason(int status) {
+  char text[FLEN_STATUS] = {0};
+  fits_get_errstatus(status, text);
+  fits_clear_errmsg();
+  return "cfitsio: " + std::string(text);
+}
+
+// Closes the file on every path out; a write closes explicitly to see the
+// status of the final flush.
+struct FitsFile {
+  fitsfile* f = nullptr;
+  ~FitsFile() {
+    if (f != nullptr) {
+      int ignored = 0;
+      fits_close_file(f, &ignored);
+      fits_clear_errmsg();
+    }
+  }
+};
+
+std::string upper(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  return text;
+}
+
+std::string trim(const std::string& text) {
+  const size_t begin = text.find_first_not_of(' ');
+  if (begin == std::string::npos) return {};
+  return text.substr(begin, text.find_last_not_of(' ') - begin + 1);
+}
+
+// The 80-character cards of KEYWORD = 'VALUE' / COMMENT. Keywords longer
+// than 8 characters use the HIERARCH convention; values too long for one
+// card continue on CONTINUE cards (long-string convention, FITS 4.0 section
+// 4.2.1.2), each piece but the last ending in '&'. We build the cards
+// ourselves because cfitsio's writer lets the value crowd the comment off
+// the card, and the comment carries the metadata key: here it always ends
+// the last card whole. cfitsio stops reading at an empty piece, so the last
+// card always holds part of a non-empty value (metadata keys are short
+// enough for an empty value and the comment to share one card).
+std::vector<std::string> string_cards(const std::string& keyword, const std::string& value,
+                                      const std::string& comment) {
+  std::string prefix = keyword.size() <= 8 ? keyword + std::string(8 - keyword.size(), ' ') + "= "
+                                           : "HIERARCH " + keyword + " = ";
+  // Quotes are doubled inside FITS strings; a doubled quote is never split.
+  std::vector<std::string> tokens;
+  for (char c : value) tokens.push_back(c == '\'' ? "''" : std::string(1, c));
+  const std::string tail = comment.empty() ? "" : " / " + comment;
+  std::vector<std::string> cards;
+  size_t next = 0;
+  while (true) {
+    const size_t room = 80 - prefix.size() - 2;  // between the quotes
+    std::string rest;
+    for (size_t i = next; i < tokens.size(); ++i) rest += tokens[i];
+    if (rest.size() + tail.size() <= room || next + 1 >= tokens.size()) {
+      cards.push_back(prefix + "'" + rest + "'" + tail);
+      return cards;
+    }
+    std::string piece;  // may be empty on a crowded first card
+    while (next + 1 < tokens.size() && piece.size() + tokens[next].size() + 1 <= room) piece += tokens[next++];
+    cards.push_back(prefix + "'" + piece + "&'");
+    prefix = "CONTINUE  ";
+  }
+}
+
+// Reads one open file; every failure names the file and the keyword.
+class Reader {
+ public:
+  Reader(const std::string& path, fitsfile* f) : path_(path), f_(f) {}
+
+  // The value type of a keyword's first card: 'C' string, 'I' integer, 'F'
+  // float, 'L' logical; '\0' when there is no such keyword.
+  char type_of(const std::string& name) const {
+    char card[FLEN_CARD] = {0}, value[FLEN_VALUE] = {0}, comment[FLEN_COMMENT] = {0};
+    int status = 0;
+    if (fits_read_card(f_, const_cast<char*>(name.c_str()), card, &status) != 0) {
+      fits_clear_errmsg();
+      return '\0';
+    }
+    char type = '\0';
+    if (fits_parse_value(card, value, comment, &status) != 0 || value[0] == '\0' ||
+        fits_get_keytype(value, &type, &status) != 0) {
+      fits_clear_errmsg();
+      return '?';
+    }
+    return type;
+  }
+
+  // A string keyword, continued or not, and the comment of its last card.
+  std::string string_key(const std::string& name, const std::string& expected,
+                         std::string* comment = nullptr) const {
+    const char type = type_of(name);
+    if (type == '\0') fail(path_, name, expected, "no such keyword (not a nebula image?)");
+    if (type != 'C') fail(path_, name, expected, "a keyword that is not a string");
+    char* text = nullptr;
+    char last_comment[FLEN_COMMENT] = {0};
+    int status = 0;
+    if (fits_read_key_longstr(f_, const_cast<char*>(name.c_str()), &text, last_comment, &status) != 0)
+      fail(path_, name, expected, cfitsio_reason(status));
+    std::string value = text != nullptr ? text : "";
+    if (text != nullptr) fits_free_memory(text, &status);
+    if (comment != nullptr) *comment = trim(last_comment);
+    return value;
+  }
+
+  double double_key(const std::string& name, const std::string& expected) const {
+    const char type = type_of(name);
+    if (type == '\0') fail(path_, name, expected, "no such keyword (not a nebula image?)");
+    if (type != 'F' && type != 'I') fail(path_, name, expected, "a keyword that is not a number");
+    double value = 0;
+    int status = 0;
+    if (fits_read_key_dbl(f_, const_cast<char*>(name.c_str()), &value, nullptr, &status) != 0)
+      fail(path_, name, expected, cfitsio_reason(status));
+    return value;
+  }
+
+  // The metadata entries, in header order: string keywords whose comment
+  // carries the marker and the key, which must match the keyword.
+  std::vector<std::pair<std::string, std::string>> entries() const {
+    int count = 0, status = 0;
+    if (fits_get_hdrspace(f_, &count, nullptr, &status) != 0)
+      fail(path_, "header", "a readable header", cfitsio_reason(status));
+    std::vector<std::pair<std::string, std::string>> found;
+    for (int i = 1; i <= count; ++i) {
+      char card[FLEN_CARD] = {0}, name[FLEN_KEYWORD] = {0};
+      int length = 0;
+      if (fits_read_record(f_, i, card, &status) != 0 ||
+          fits_get_keyname(card, name, &length, &status) != 0)
+        fail(path_, "header card " + std::to_string(i), "a readable card", cfitsio_reason(status));
+      const std::string keyword = name;
+      if (keyword.empty() || keyword == "COMMENT" || keyword == "HISTORY" || keyword == "CONTINUE") continue;
+      if (type_of(keyword) != 'C') continue;
+      std::string comment;
+      const std::string value = string_key(keyword, "a string", &comment);
+      if (comment.rfind(kEntryMarker, 0) != 0) continue;
+      const std::string key = comment.substr(kEntryMarker.size());
+      if (upper(key) != keyword)
+        fail(path_, keyword, "the comment '" + kEntryMarker + "KEY' with KEY matching the keyword",
+             "'" + comment + "'");
+      found.emplace_back(key, value);
+    }
+    return found;
+  }
+
+ private:
+  const std::string& path_;
+  fitsfile* f_;
+};
+
+}  // namespace
+
+void write_fits(const Image& image, const ImageMetadata& metadata, const std::string& file_name) {
+  const std::lock_guard<std::mutex> lock(fits_mutex);
+  // cfitsio creates the file itself and refuses one that exists. Its
+  // "disk file" calls take the name literally, where the plain ones would
+  // parse brackets and a leading '!' as instructions.
+  std::error_code ec;
+  std::filesystem::remove(file_name, ec);
+  FitsFile fits;
+  int status = 0;
+  if (fits_create_diskfile(&fits.f, const_cast<char*>(file_name.c_str()), &status) != 0) {
+    fits.f = nullptr;
+    throw Error("creating the FITS file (" + cfitsio_reason(status) + ")");
+  }
+  long axes[3] = {image.width, image.height, static_cast<long>(image.bands.size())};
+  if (fits_create_img(fits.f, FLOAT_IMG, 3, axes, &status) != 0)
+    throw Error("creating the FITS image (" + cfitsio_reason(status) + ")");
+
+  bool continued = false;
+  auto write_string = [&](const std::string& keyword, const std::string& value, const std::string& comment) {
+    const std::vector<std::string> cards = string_cards(keyword, value, comment);
+    continued = continued || cards.size() > 1;
+    for (const std::string& card : cards)
+      if (fits_write_record(fits.f, card.c_str(), &status) != 0)
+        throw Error("writing keyword " + keyword + " (" + cfitsio_reason(status) + ")");
+  };
+  write_string("BUNIT", metadata.units, "unit of the pixel values");
+  for (size_t b = 0; b < image.bands.size(); ++b)
+    write_string("BAND" + std::to_string(b + 1), image.bands[b], "band of image plane " + std::to_string(b + 1));
+  // -17: seventeen significant digits, enough for any double to read back exactly.
+  if (fits_write_key_dbl(fits.f, "EXPOSURE", metadata.exposure, -17,
+                         "display scale before tone mapping (not a time)", &status) != 0)
+    throw Error("writing keyword EXPOSURE (" + cfitsio_reason(status) + ")");
+  for (const auto& [key, value] : metadata.entries) write_string(upper(key), value, kEntryMarker + key);
+  if (continued && fits_write_key_longwarn(fits.f, &status) != 0)
+    throw Error("writing keyword LONGSTRN (" + cfitsio_reason(status) + ")");
+
+  // Plane by plane, top row last (FITS rows go up).
+  const size_t width = image.width, plane = image.plane_size();
+  std::vector<float> rows(plane);
+  for (size_t b = 0; b < image.bands.size(); ++b) {
+    for (int y = 0; y < image.height; ++y) {
+      const float* source = &image.pixels[b * plane + size_t(y) * width];
+      std::copy(source, source + width, rows.begin() + size_t(image.height - 1 - y) * width);
+    }
+    if (fits_write_img(fits.f, TFLOAT, static_cast<LONGLONG>(b * plane + 1), static_cast<LONGLONG>(plane),
+                       rows.data(), &status) != 0)
+      throw Error("writing the pixels (" + cfitsio_reason(status) + ")");
+  }
+  if (fits_write_chksum(fits.f, &status) != 0)
+    throw Error("writing the checksums (" + cfitsio_reason(status) + ")");
+  fitsfile* f = fits.f;
+  fits.f = nullptr;
+  if (fits_close_file(f, &status) != 0) throw Error("writing the FITS file (" + cfitsio_reason(status) + ")");
+}
+
+Image read_fits(const std::string& path, ImageMetadata* metadata) {
+  const std::lock_guard<std::mutex> lock(fits_mutex);
+  FitsFile fits;
+  int status = 0;
+  if (fits_open_diskfile(&fits.f, path.c_str(), READONLY, &status) != 0) {
+    fits.f = nullptr;
+    throw Error(path + ": cannot open as FITS (" + cfitsio_reason(status) + "); expected a nebula image");
+  }
+  const Reader r(path, fits.f);
+
+  int bitpix = 0, naxis = 0;
+  long axes[3] = {0, 0, 0};
+  if (fits_get_img_param(fits.f, 3, &bitpix, &naxis, axes, &status) != 0)
+    fail(path, "primary HDU", "an image", cfitsio_reason(status));
+  if (naxis != 3) fail(path, "NAXIS", "3 (width, height, bands)", std::to_string(naxis));
+  const std::string shape = std::to_string(axes[0]) + " x " + std::to_string(axes[1]) + " x " +
+                            std::to_string(axes[2]);
+  if (axes[0] <= 0 || axes[1] <= 0 || axes[2] <= 0 || axes[0] > INT_MAX || axes[1] > INT_MAX ||
+      size_t(axes[2]) > kMaxElements / size_t(axes[0]) / size_t(axes[1]))
+    fail(path, "NAXIS1..3", "an image of 1 to 2^29 values", shape);
+  const size_t count = size_t(axes[0]) * size_t(axes[1]) * size_t(axes[2]);
+
+  // The data must lie inside the file: a truncated file is refused before
+  // a large allocation.
+  LONGLONG header_start = 0, data_start = 0, data_end = 0;
+  if (fits_get_hduaddrll(fits.f, &header_start, &data_start, &data_end, &status) != 0)
+    fail(path, "primary HDU", "a readable header", cfitsio_reason(status));
+  std::error_code ec;
+  const auto file_size = std::filesystem::file_size(path, ec);
+  if (!ec && size_t(data_start) + count * size_t(std::abs(bitpix) / 8) > file_size)
+    fail(path, "data", shape + " pixels of BITPIX " + std::to_string(bitpix),
+         "a file that ends early (truncated?)");
+
+  // Files written here carry checksums; a mismatch means damage.
+  int data_ok = 0, header_ok = 0;
+  if (fits_verify_chksum(fits.f, &data_ok, &header_ok, &status) != 0)
+    fail(path, "CHECKSUM", "a verifiable checksum", cfitsio_reason(status));
+  // CHECKSUM covers header and data, so damaged pixels fail both: name the data.
+  if (data_ok < 0) fail(path, "DATASUM", "the checksum of the pixels", "a mismatch (damaged file?)");
+  if (header_ok < 0) fail(path, "CHECKSUM", "the checksum of the header", "a mismatch (damaged file?)");
+
+  Image image;
+  image.width = static_cast<int>(axes[0]);
+  image.height = static_cast<int>(axes[1]);
+  for (long b = 1; b <= axes[2]; ++b)
+    image.bands.push_back(r.string_key("BAND" + std::to_string(b),
+                                       "a string naming band " + std::to_string(b) + " of NAXIS3 = " +
+                                           std::to_string(axes[2])));
+  ImageMetadata m;
+  m.units = r.string_key("BUNIT", "a string (the unit of the pixels)");
+  m.exposure = r.double_key("EXPOSURE", "a number (the display scale)");
+  if (!std::isfinite(m.exposure) || m.exposure <= 0)
+    fail(path, "EXPOSURE", "a finite positive number", exact_text(m.exposure));
+  m.entries = r.entries();
+
+  image.pixels.resize(count);
+  const size_t width = image.width, plane = image.plane_size();
+  std::vector<float> rows(plane);
+  for (size_t b = 0; b < image.bands.size(); ++b) {
+    float no_null_check = 0;  // 0: values pass as stored, NaN included (refused by read_image)
+    int any_null = 0;
+    if (fits_read_img(fits.f, TFLOAT, static_cast<LONGLONG>(b * plane + 1), static_cast<LONGLONG>(plane),
+                      &no_null_check, rows.data(), &any_null, &status) != 0)
+      fail(path, "data", "readable pixels", cfitsio_reason(status));
+    for (int y = 0; y < image.height; ++y) {
+      const float* source = &rows[size_t(image.height - 1 - y) * width];
+      std::copy(source, source + width, image.pixels.begin() + b * plane + size_t(y) * width);
+    }
+  }
+  *metadata = m;
+  return image;
+}
+
+}  // namespace nebula::imageio_detail

@@ -1,0 +1,317 @@
+// The HDF5 image file: /image float32 [bands][height][width], row 0 at the
+// top, one checksummed chunk per band, with the band names, units, exposure,
+// schema version and metadata entries as attributes of the root group
+// (imageio/README.md).
+#include <hdf5.h>
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <filesystem>
+#include <mutex>
+#include <vector>
+
+#include "core/error.h"
+#include "imageio/image_formats.h"
+
+namespace nebula::imageio_detail {
+
+namespace {
+
+// HDF5 1.10 is not thread-safe unless built so. tables/table_file.cpp keeps
+// its own mutex for the same reason; this one is deliberately separate so the
+// two libraries stay independent. Debian's build is thread-safe, so the two
+// locks not excluding each other is harmless there.
+std::mutex hdf5_mutex;
+
+// Owns an HDF5 identifier and closes it with the matching function.
+class Handle {
+ public:
+  using Closer = herr_t (*)(hid_t);
+  Handle(hid_t id, Closer closer) : id_(id), closer_(closer) {}
+  ~Handle() { close(); }
+  Handle(Handle&& other) noexcept : id_(other.id_), closer_(other.closer_) {
+    other.id_ = H5I_INVALID_HID;
+  }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  bool valid() const { return id_ >= 0; }
+  hid_t get() const { return id_; }
+  // Closes now and says whether it worked (a file close writes it out).
+  bool close() {
+    if (id_ < 0) return true;
+    const herr_t status = closer_(id_);
+    id_ = H5I_INVALID_HID;
+    return status >= 0;
+  }
+
+ private:
+  hid_t id_;
+  Closer closer_;
+};
+
+// The innermost entry of HDF5's error stack (often the system call's
+// complaint), or "" when there is none.
+std::string hdf5_reason() {
+  std::string reason;
+  auto take_first = [](unsigned n, const H5E_error2_t* e, void* out) -> herr_t {
+    if (n == 0 && e->desc != nullptr) *static_cast<std::string*>(out) = e->desc;
+    return 0;
+  };
+  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, take_first, &reason);
+  std::replace(reason.begin(), reason.end(), '\n', ' ');
+  return reason;
+}
+
+std::string with_reason(const std::string& what) {
+  const std::string reason = hdf5_reason();
+  return reason.empty() ? what : what + " (" + reason + ")";
+}
+
+// ---------------------------------------------------------------- writing
+
+// Fixed-length NUL-terminated strings: they live in the checksummed
+// attribute message, not in the unchecked global heap of variable strings.
+void write_string(hid_t object, const std::string& name, const std::string& value) {
+  Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  if (!type.valid() || !space.valid() || H5Tset_size(type.get(), value.size() + 1) < 0 ||
+      H5Tset_strpad(type.get(), H5T_STR_NULLTERM) < 0)
+    throw Error(with_reason("making the string attribute " + name));
+  Handle attr(H5Acreate2(object, name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT),
+              H5Aclose);
+  if (!attr.valid() || H5Awrite(attr.get(), type.get(), value.c_str()) < 0)
+    throw Error(with_reason("writing attribute " + name));
+}
+
+void write_scalar(hid_t object, const char* name, hid_t file_type, hid_t memory_type,
+                  const void* value) {
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  Handle attr(H5Acreate2(object, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  if (!space.valid() || !attr.valid() || H5Awrite(attr.get(), memory_type, value) < 0)
+    throw Error(with_reason(std::string("writing attribute ") + name));
+}
+
+// ---------------------------------------------------------------- reading
+
+const char* class_name(H5T_class_t c) {
+  switch (c) {
+    case H5T_INTEGER: return "integer";
+    case H5T_FLOAT: return "float";
+    case H5T_STRING: return "string";
+    case H5T_COMPOUND: return "compound";
+    case H5T_ENUM: return "enum";
+    case H5T_VLEN: return "variable-length";
+    case H5T_ARRAY: return "array";
+    default: return "other";
+  }
+}
+
+// Reads one open file; every failure names the file and the field.
+class Reader {
+ public:
+  Reader(const std::string& path, hid_t file) : path_(path), file_(file) {}
+
+  // Opens a scalar attribute of the root group of class WANT.
+  Handle open_attribute(const std::string& name, const std::string& expected, H5T_class_t want) const {
+    const htri_t exists = H5Aexists(file_, name.c_str());
+    if (exists < 0) fail(path_, name, expected, with_reason("an unreadable root group (damaged file?)"));
+    if (exists == 0) fail(path_, name, expected + " on /", "no such attribute (not a nebula image?)");
+    Handle attr(H5Aopen(file_, name.c_str(), H5P_DEFAULT), H5Aclose);
+    if (!attr.valid()) fail(path_, name, expected, with_reason("an attribute that cannot be opened"));
+    Handle type(H5Aget_type(attr.get()), H5Tclose);
+    const H5T_class_t cls = type.valid() ? H5Tget_class(type.get()) : H5T_NO_CLASS;
+    if (cls != want) fail(path_, name, expected, std::string("an attribute of class ") + class_name(cls));
+    Handle space(H5Aget_space(attr.get()), H5Sclose);
+    const hssize_t points = space.valid() ? H5Sget_simple_extent_npoints(space.get()) : -1;
+    if (points != 1) fail(path_, name, expected, std::to_string(points) + " elements");
+    return attr;
+  }
+
+  std::string string_attribute(const std::string& name) const {
+    const std::string expected = "a scalar string attribute";
+    const Handle attr = open_attribute(name, expected, H5T_STRING);
+    Handle file_type(H5Aget_type(attr.get()), H5Tclose);
+    Handle memory_type(H5Tcopy(H5T_C_S1), H5Tclose);
+    if (!file_type.valid() || !memory_type.valid())
+      fail(path_, name, expected, with_reason("an unreadable type"));
+    H5Tset_cset(memory_type.get(), H5Tget_cset(file_type.get()));
+    if (H5Tis_variable_str(file_type.get()) > 0) {
+      H5Tset_size(memory_type.get(), H5T_VARIABLE);
+      char* text = nullptr;
+      if (H5Aread(attr.get(), memory_type.get(), &text) < 0) fail(path_, name, expected, with_reason("a read error"));
+      std::string value = text != nullptr ? text : "";
+      H5free_memory(text);
+      return value;
+    }
+    const size_t size = H5Tget_size(file_type.get());
+    if (size == 0 || size > (1u << 20))
+      fail(path_, name, expected, "a fixed-length string of " + std::to_string(size) + " bytes");
+    H5Tset_size(memory_type.get(), size);
+    H5Tset_strpad(memory_type.get(), H5T_STR_NULLPAD);
+    std::vector<char> buffer(size + 1, '\0');
+    if (H5Aread(attr.get(), memory_type.get(), buffer.data()) < 0)
+      fail(path_, name, expected, with_reason("a read error"));
+    std::string value(buffer.data());  // up to the first NUL
+    if (H5Tget_strpad(file_type.get()) == H5T_STR_SPACEPAD)
+      while (!value.empty() && value.back() == ' ') value.pop_back();
+    return value;
+  }
+
+  double double_attribute(const std::string& name) const {
+    const std::string expected = "a scalar float attribute";
+    const Handle attr = open_attribute(name, expected, H5T_FLOAT);
+    double value = 0;
+    if (H5Aread(attr.get(), H5T_NATIVE_DOUBLE, &value) < 0) fail(path_, name, expected, with_reason("a read error"));
+    return value;
+  }
+
+  long long integer_attribute(const std::string& name) const {
+    const std::string expected = "a scalar integer attribute";
+    const Handle attr = open_attribute(name, expected, H5T_INTEGER);
+    long long value = 0;
+    if (H5Aread(attr.get(), H5T_NATIVE_LLONG, &value) < 0) fail(path_, name, expected, with_reason("a read error"));
+    return value;
+  }
+
+ private:
+  const std::string& path_;
+  hid_t file_;
+};
+
+// The root group's attribute names in the order they were written (files
+// without a creation-order index: by name).
+std::vector<std::string> attribute_names(const std::string& path, hid_t file) {
+  std::vector<std::string> names;
+  auto collect = [](hid_t, const char* name, const H5A_info_t*, void* out) -> herr_t {
+    static_cast<std::vector<std::string>*>(out)->push_back(name);
+    return 0;
+  };
+  if (H5Aiterate2(file, H5_INDEX_CRT_ORDER, H5_ITER_INC, nullptr, collect, &names) >= 0) return names;
+  names.clear();
+  if (H5Aiterate2(file, H5_INDEX_NAME, H5_ITER_INC, nullptr, collect, &names) >= 0) return names;
+  fail(path, "/", "a readable list of attributes", with_reason("an unreadable root group (damaged file?)"));
+}
+
+}  // namespace
+
+void write_hdf5(const Image& image, const ImageMetadata& metadata, const std::string& file_name) {
+  const std::lock_guard<std::mutex> lock(hdf5_mutex);
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // one line of ours instead of HDF5's stack
+
+  // The core driver builds the file in memory and writes it out on close:
+  // HDF5 1.10 recovers from a failed write there (tables/table_file.cpp has
+  // the story). The 1.10 format (read by HDF5 >= 1.10) checksums all the
+  // metadata, the chunk index included; the 1.8 format's chunk index has
+  // no checksum, and a damaged one there passed pixels off as unfiltered.
+  // Tracking creation order keeps the metadata entries in the order given.
+  const size_t bytes = image.pixels.size() * sizeof(float);
+  Handle access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  Handle creation(H5Pcreate(H5P_FILE_CREATE), H5Pclose);
+  if (!access.valid() || !creation.valid() ||
+      H5Pset_fapl_core(access.get(), bytes + (size_t(1) << 20), 1) < 0 ||
+      H5Pset_libver_bounds(access.get(), H5F_LIBVER_V110, H5F_LIBVER_LATEST) < 0 ||
+      H5Pset_attr_creation_order(creation.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED) < 0)
+    throw Error(with_reason("setting up HDF5 file access"));
+  Handle file(H5Fcreate(file_name.c_str(), H5F_ACC_TRUNC, creation.get(), access.get()), H5Fclose);
+  if (!file.valid()) throw Error(with_reason("creating the HDF5 file"));
+  const hid_t f = file.get();
+
+  const hsize_t dims[3] = {image.bands.size(), hsize_t(image.height), hsize_t(image.width)};
+  Handle space(H5Screate_simple(3, dims, nullptr), H5Sclose);
+  if (!space.valid()) throw Error(with_reason("creating the dataspace of /image"));
+  // One chunk per band, each with a Fletcher-32 checksum: damaged pixels
+  // are refused on reading, as damaged metadata are.
+  const hsize_t chunk[3] = {1, dims[1], dims[2]};
+  Handle layout(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  if (!layout.valid() || H5Pset_chunk(layout.get(), 3, chunk) < 0 || H5Pset_fletcher32(layout.get()) < 0)
+    throw Error(with_reason("setting up the layout of /image"));
+  Handle set(H5Dcreate2(f, "/image", H5T_IEEE_F32LE, space.get(), H5P_DEFAULT, layout.get(), H5P_DEFAULT),
+             H5Dclose);
+  if (!set.valid()) throw Error(with_reason("creating /image"));
+  if (H5Dwrite(set.get(), H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, image.pixels.data()) < 0)
+    throw Error(with_reason("writing /image"));
+  if (!set.close()) throw Error(with_reason("closing /image"));
+
+  const int schema = kSchemaVersion;
+  write_scalar(f, kSchemaName, H5T_STD_I32LE, H5T_NATIVE_INT, &schema);
+  write_string(f, kBandsName, join_bands(image.bands));
+  write_string(f, kUnitsName, metadata.units);
+  write_scalar(f, kExposureName, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &metadata.exposure);
+  for (const auto& [key, value] : metadata.entries) write_string(f, key, value);
+
+  if (!file.close()) throw Error(with_reason("writing the HDF5 file"));
+}
+
+Image read_hdf5(const std::string& path, ImageMetadata* metadata) {
+  const std::lock_guard<std::mutex> lock(hdf5_mutex);
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+
+  if (H5Fis_hdf5(path.c_str()) <= 0)
+    throw Error(path + ": not an HDF5 file (no HDF5 signature); expected a nebula image");
+  Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  if (!file.valid()) throw Error(with_reason(path + ": cannot open as HDF5 (truncated or corrupt?)"));
+  const hid_t f = file.get();
+  const Reader r(path, f);
+
+  // The schema first: a newer layout would otherwise fail confusingly.
+  const long long schema = r.integer_attribute(kSchemaName);
+  if (schema != kSchemaVersion)
+    fail(path, kSchemaName, "1 (the only image schema this reader knows)", std::to_string(schema));
+
+  const std::string expected = "a 3-D float dataset [bands][height][width]";
+  const htri_t exists = H5Lexists(f, "/image", H5P_DEFAULT);
+  if (exists < 0) fail(path, "/image", expected, with_reason("an unreadable root group (damaged file?)"));
+  if (exists == 0) fail(path, "/image", expected, "no such dataset");
+  Handle set(H5Dopen2(f, "/image", H5P_DEFAULT), H5Dclose);
+  if (!set.valid()) fail(path, "/image", expected, with_reason("an object that cannot be opened as a dataset"));
+  Handle type(H5Dget_type(set.get()), H5Tclose);
+  const H5T_class_t cls = type.valid() ? H5Tget_class(type.get()) : H5T_NO_CLASS;
+  if (cls != H5T_FLOAT) fail(path, "/image", expected, std::string("a dataset of class ") + class_name(cls));
+  Handle space(H5Dget_space(set.get()), H5Sclose);
+  const int rank = space.valid() ? H5Sget_simple_extent_ndims(space.get()) : -1;
+  if (rank != 3) fail(path, "/image", expected, "rank " + std::to_string(rank));
+  hsize_t dims[3] = {0, 0, 0};
+  H5Sget_simple_extent_dims(space.get(), dims, nullptr);
+  const std::string shape =
+      "[" + std::to_string(dims[0]) + "][" + std::to_string(dims[1]) + "][" + std::to_string(dims[2]) + "]";
+  if (dims[0] == 0 || dims[1] == 0 || dims[2] == 0 || dims[1] > INT_MAX || dims[2] > INT_MAX ||
+      dims[0] > kMaxElements / dims[1] / dims[2])
+    fail(path, "/image", expected + " of 1 to 2^29 values", shape);
+  // The data must fit in the file: a truncated file is refused before a
+  // large allocation. (Our files are chunked, with no single offset; a
+  // contiguous dataset from elsewhere must also end inside the file.)
+  const hsize_t stored = H5Dget_storage_size(set.get());
+  const haddr_t offset = H5Dget_offset(set.get());
+  std::error_code ec;
+  const auto file_size = std::filesystem::file_size(path, ec);
+  if (!ec && (stored > file_size || (offset != HADDR_UNDEF && offset + stored > file_size)))
+    fail(path, "/image", expected + " inside the file", "data past its end (truncated file?)");
+
+  Image image;
+  image.width = static_cast<int>(dims[2]);
+  image.height = static_cast<int>(dims[1]);
+  image.pixels.resize(dims[0] * dims[1] * dims[2]);
+  if (H5Dread(set.get(), H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, image.pixels.data()) < 0)
+    fail(path, "/image", "a readable dataset", with_reason("an HDF5 read error"));
+
+  const std::string bands = r.string_attribute(kBandsName);
+  image.bands = split_bands(bands);
+  if (image.bands.size() != dims[0])
+    fail(path, kBandsName, std::to_string(dims[0]) + " comma-separated band names (the first dimension of /image)",
+         "'" + bands + "'");
+
+  ImageMetadata m;
+  m.units = r.string_attribute(kUnitsName);
+  m.exposure = r.double_attribute(kExposureName);
+  if (!std::isfinite(m.exposure) || m.exposure <= 0)
+    fail(path, kExposureName, "a finite positive number", exact_text(m.exposure));
+  for (const std::string& name : attribute_names(path, f)) {
+    if (name == kSchemaName || name == kBandsName || name == kUnitsName || name == kExposureName) continue;
+    m.entries.emplace_back(name, r.string_attribute(name));
+  }
+  *metadata = m;
+  return image;
+}
+
+}  // namespace nebula::imageio_detail

@@ -1,0 +1,166 @@
+// EXR and PNG through OpenImageIO. EXR: one float32 channel per band,
+// named by the band, zip-compressed (lossless), metadata as "nebula:..."
+// attributes. PNG: 8-bit sRGB, tone-mapped by imageio/tone_map.h.
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "core/error.h"
+#include "imageio/image_formats.h"
+#include "imageio/tone_map.h"
+
+namespace nebula {
+
+bool openimageio_available() { return true; }
+
+namespace imageio_detail {
+
+namespace {
+
+// Attribute names. OpenEXR keeps attributes sorted by name and channels in
+// its own order, so the band order and the entries' order are stored too.
+const std::string kPrefix = "nebula:";
+const std::string kEntryPrefix = "nebula:entry:";
+const std::string kEntryOrder = "nebula:entry_order";
+
+// OpenImageIO's messages may span lines; ours are one line.
+std::string one_line(std::string text) {
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  return text.empty() ? "no reason given" : text;
+}
+
+void add_metadata(OIIO::ImageSpec& spec, const ImageMetadata& m) {
+  spec.attribute("Software", "nebula");
+  spec.attribute(kPrefix + kSchemaName, kSchemaVersion);
+  spec.attribute(kPrefix + kUnitsName, m.units);
+  spec.attribute(kPrefix + kExposureName, exact_text(m.exposure));
+  std::vector<std::string> keys;
+  for (const auto& [key, value] : m.entries) {
+    spec.attribute(kEntryPrefix + key, value);
+    keys.push_back(key);
+  }
+  spec.attribute(kEntryOrder, join_bands(keys));
+}
+
+void write_with(const char* format, const OIIO::ImageSpec& spec, OIIO::TypeDesc type,
+                const void* pixels, const std::string& file_name) {
+  // By format name: the temporary file's extension is not the target's.
+  auto out = OIIO::ImageOutput::create(format);
+  if (!out) throw Error(std::string("OpenImageIO has no ") + format + " writer (" + one_line(OIIO::geterror()) + ")");
+  if (!out->open(file_name, spec)) throw Error("OpenImageIO: " + one_line(out->geterror()));
+  if (!out->write_image(type, pixels)) throw Error("OpenImageIO: " + one_line(out->geterror()));
+  if (!out->close()) throw Error("OpenImageIO: " + one_line(out->geterror()));
+}
+
+}  // namespace
+
+void write_exr(const Image& image, const ImageMetadata& metadata, const std::string& file_name) {
+  const int channels = static_cast<int>(image.bands.size());
+  OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::FLOAT);
+  spec.channelnames = image.bands;
+  spec.attribute("compression", "zip");
+  spec.attribute(kPrefix + kBandsName, join_bands(image.bands));
+  add_metadata(spec, metadata);
+  // OpenImageIO takes pixels interleaved; ours are planes.
+  const size_t plane = image.plane_size();
+  std::vector<float> interleaved(image.pixels.size());
+  for (size_t i = 0; i < plane; ++i)
+    for (int c = 0; c < channels; ++c) interleaved[i * channels + c] = image.pixels[c * plane + i];
+  write_with("openexr", spec, OIIO::TypeDesc::FLOAT, interleaved.data(), file_name);
+}
+
+void write_png(const Image& image, const ImageMetadata& metadata, const std::string& file_name) {
+  // Red, green, blue from R, V, B; one grey channel from a single band.
+  std::vector<int> source;
+  if (image.bands.size() == 1) {
+    source = {0};
+  } else {
+    for (const char* band : {"R", "V", "B"})
+      source.push_back(static_cast<int>(
+          std::find(image.bands.begin(), image.bands.end(), band) - image.bands.begin()));
+  }
+  const int channels = static_cast<int>(source.size());
+  OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::UINT8);
+  spec.attribute("oiio:ColorSpace", "sRGB");
+  spec.attribute(kPrefix + kBandsName, join_bands(image.bands));
+  spec.attribute("nebula:tone_map", "value x exposure, clamped to [0, 1], sRGB curve (IEC 61966-2-1)");
+  add_metadata(spec, metadata);
+  const size_t plane = image.plane_size();
+  std::vector<uint8_t> levels(plane * channels);
+  for (size_t i = 0; i < plane; ++i)
+    for (int c = 0; c < channels; ++c)
+      levels[i * channels + c] = srgb_level(image.pixels[source[c] * plane + i], metadata.exposure);
+  write_with("png", spec, OIIO::TypeDesc::UINT8, levels.data(), file_name);
+}
+
+Image read_exr(const std::string& path, ImageMetadata* metadata) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw Error(path + ": cannot open as EXR (" + one_line(OIIO::geterror()) + ")");
+  if (std::string(in->format_name()) != "openexr")
+    throw Error(path + ": not an EXR file (OpenImageIO reads it as " + in->format_name() + ")");
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.deep) fail(path, "image", "a flat image", "a deep image");
+  const std::string shape = std::to_string(spec.width) + " x " + std::to_string(spec.height) +
+                            " x " + std::to_string(spec.nchannels);
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth != 1 ||
+      size_t(spec.nchannels) > kMaxElements / size_t(spec.width) / size_t(spec.height))
+    fail(path, "image", "a 2-D image of 1 to 2^29 values", shape);
+
+  const size_t plane = size_t(spec.width) * spec.height;
+  std::vector<float> interleaved(plane * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, interleaved.data()))
+    fail(path, "pixels", "readable pixels", "OpenImageIO: " + one_line(in->geterror()));
+
+  // Our band order, whatever order the file keeps its channels in.
+  std::vector<std::string> bands = spec.channelnames;
+  const std::string stored = spec.get_string_attribute(kPrefix + kBandsName);
+  if (!stored.empty()) {
+    bands = split_bands(stored);
+    std::vector<std::string> a = bands, b = spec.channelnames;
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    if (a != b)
+      fail(path, kPrefix + kBandsName, "the channel names in some order",
+           "'" + stored + "' for channels " + join_bands(spec.channelnames));
+  }
+  Image image;
+  image.width = spec.width;
+  image.height = spec.height;
+  image.bands = bands;
+  image.pixels.resize(plane * bands.size());
+  for (size_t b = 0; b < bands.size(); ++b) {
+    const size_t c = std::find(spec.channelnames.begin(), spec.channelnames.end(), bands[b]) -
+                     spec.channelnames.begin();
+    for (size_t i = 0; i < plane; ++i) image.pixels[b * plane + i] = interleaved[i * spec.nchannels + c];
+  }
+
+  // Any EXR is accepted; what it lacks keeps ImageMetadata's defaults. One
+  // of ours from a newer layout is refused.
+  const int schema = spec.get_int_attribute(kPrefix + kSchemaName, kSchemaVersion);
+  if (schema != kSchemaVersion)
+    fail(path, kPrefix + kSchemaName, "1 (the only image schema this reader knows)", std::to_string(schema));
+  ImageMetadata m;
+  m.units = spec.get_string_attribute(kPrefix + kUnitsName, m.units);
+  const std::string exposure = spec.get_string_attribute(kPrefix + kExposureName);
+  if (!exposure.empty() && (!parse_double(exposure, m.exposure) || !(m.exposure > 0) || !std::isfinite(m.exposure)))
+    fail(path, kPrefix + kExposureName, "a finite positive number", "'" + exposure + "'");
+  const std::string order = spec.get_string_attribute(kEntryOrder);
+  if (!order.empty())
+    for (const std::string& key : split_bands(order)) {
+      // OpenImageIO writes no attribute for an empty string: a listed entry
+      // without one is empty.
+      const OIIO::ParamValue* p = spec.find_attribute(kEntryPrefix + key);
+      if (p != nullptr && p->type() != OIIO::TypeDesc::STRING)
+        fail(path, kEntryPrefix + key, "a string attribute", "an attribute of type " + std::string(p->type().c_str()));
+      m.entries.emplace_back(key, p != nullptr ? p->get_string() : std::string());
+    }
+  *metadata = m;
+  return image;
+}
+
+}  // namespace imageio_detail
+
+}  // namespace nebula

@@ -1,0 +1,359 @@
+#include "imageio/image_output.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <regex>
+#include <set>
+
+#include "core/error.h"
+#include "imageio/image_formats.h"
+
+namespace nebula {
+
+namespace imageio_detail {
+
+void fail(const std::string& path, const std::string& field, const std::string& expected,
+          const std::string& found) {
+  throw Error(path + ": " + field + ": expected " + expected + ", found " + found);
+}
+
+std::string join_bands(const std::vector<std::string>& bands) {
+  std::string text;
+  for (const std::string& band : bands) text += (text.empty() ? "" : ",") + band;
+  return text;
+}
+
+std::vector<std::string> split_bands(const std::string& text) {
+  std::vector<std::string> bands;
+  size_t begin = 0;
+  while (true) {
+    const size_t comma = text.find(',', begin);
+    bands.push_back(text.substr(begin, comma - begin));
+    if (comma == std::string::npos) return bands;
+    begin = comma + 1;
+  }
+}
+
+std::string exact_text(double value) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return std::string(buffer, result.ptr);
+}
+
+bool parse_double(const std::string& text, double& value) {
+  const auto result = std::from_chars(text.data(), text.data() + text.size(), value);
+  return result.ec == std::errc() && result.ptr == text.data() + text.size() && !text.empty();
+}
+
+}  // namespace imageio_detail
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace imageio_detail;
+
+enum class Format { Hdf5, Fits, Exr, Png };
+
+const char* const kAccepted = ".h5, .fits, .fit, .exr or .png";
+
+// The format an extension names, compared without regard to case; false
+// for anything else.
+bool format_of(const std::string& path, Format& format) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".h5") format = Format::Hdf5;
+  else if (ext == ".fits" || ext == ".fit") format = Format::Fits;
+  else if (ext == ".exr") format = Format::Exr;
+  else if (ext == ".png") format = Format::Png;
+  else return false;
+  return true;
+}
+
+std::string extension_of(const std::string& path) {
+  const std::string ext = fs::path(path).extension().string();
+  return ext.empty() ? "none" : "'" + ext + "'";
+}
+
+// ------------------------------------------------------------- the rules
+
+bool printable_ascii(const std::string& text) {
+  return std::all_of(text.begin(), text.end(), [](char c) { return c >= 32 && c <= 126; });
+}
+
+// 1 to 32 characters that are safe in an HDF5 attribute, a FITS string,
+// an EXR channel name and a comma-separated list.
+bool valid_band_name(const std::string& name) {
+  static const std::regex pattern("[A-Za-z0-9_.+-]{1,32}");
+  return std::regex_match(name, pattern);
+}
+
+bool valid_key(const std::string& key) {
+  static const std::regex pattern("[A-Za-z][A-Za-z0-9_-]{0,23}");
+  return std::regex_match(key, pattern);
+}
+
+// Names the layouts use themselves, in any case: the HDF5 attributes, and
+// the FITS keywords that describe the array (a metadata keyword BSCALE would
+// silently rescale every pixel when read) or that the layout writes.
+bool reserved_key(const std::string& key) {
+  std::string upper = key;
+  std::transform(upper.begin(), upper.end(), upper.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  static const std::set<std::string> names = {
+      "BANDS",    "UNITS",    "EXPOSURE", "SCHEMA_VERSION", "SIMPLE",  "BITPIX",  "NAXIS",
+      "EXTEND",   "BSCALE",   "BZERO",    "BLANK",          "BUNIT",   "END",     "COMMENT",
+      "HISTORY",  "CONTINUE", "LONGSTRN", "HIERARCH",       "XTENSION", "PCOUNT", "GCOUNT",
+      "GROUPS",   "CHECKSUM", "DATASUM",  "DATAMIN",        "DATAMAX"};
+  static const std::regex numbered("(NAXIS|BAND)[0-9]+");
+  return names.count(upper) > 0 || std::regex_match(upper, numbered);
+}
+
+bool trailing_blank(const std::string& text) { return !text.empty() && text.back() == ' '; }
+
+// TEXT in quotes for a message, control and non-ASCII bytes as \xNN so
+// the message stays one printable line.
+std::string quoted(const std::string& text) {
+  std::string out = "'";
+  for (unsigned char c : text) {
+    if (c >= 32 && c <= 126) {
+      out += static_cast<char>(c);
+    } else {
+      char code[8];
+      std::snprintf(code, sizeof code, "\\x%02X", c);
+      out += code;
+    }
+  }
+  return out + "'";
+}
+
+void check_image(const Image& image, const std::string& path, Format format) {
+  const std::string where = "cannot write " + path + ": ";
+  if (image.width <= 0 || image.height <= 0)
+    throw Error(where + "the image is " + std::to_string(image.width) + " x " +
+                std::to_string(image.height) + " pixels (both must be positive)");
+  if (image.bands.empty()) throw Error(where + "the image has no bands");
+  if (image.pixels.size() != image.plane_size() * image.bands.size())
+    throw Error(where + "the image holds " + std::to_string(image.pixels.size()) + " values, not " +
+                std::to_string(image.width) + " x " + std::to_string(image.height) + " x " +
+                std::to_string(image.bands.size()) + " bands");
+  if (image.pixels.size() > kMaxElements)
+    throw Error(where + "the image holds more than 2^29 values (the readers' limit)");
+  std::set<std::string> seen;
+  for (const std::string& band : image.bands) {
+    if (!valid_band_name(band))
+      throw Error(where + "band name " + quoted(band) + " is not 1 to 32 characters of [A-Za-z0-9_.+-]");
+    if (!seen.insert(band).second) throw Error(where + "band " + band + " appears twice");
+  }
+  if (format == Format::Png && image.bands.size() != 1 &&
+      seen != std::set<std::string>{"B", "V", "R"})
+    throw Error(where + "PNG needs bands B, V, R (shown as blue, green, red) or a single band "
+                "(grey); this image has " + join_bands(image.bands));
+
+  // Finite and non-negative: a NaN or a negative radiance is a bug upstream,
+  // and a file is the worst place to discover it.
+  for (size_t b = 0; b < image.bands.size(); ++b)
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x) {
+        const float v = image.at(static_cast<int>(b), x, y);
+        if (std::isfinite(v) && v >= 0.0f) continue;
+        const std::string pixel = "band " + image.bands[b] + ", pixel (x " + std::to_string(x) +
+                                  ", y " + std::to_string(y) + ") is ";
+        if (std::isnan(v)) throw Error(where + pixel + "NaN (no NaN in an output)");
+        if (std::isinf(v)) throw Error(where + pixel + (v > 0 ? "+inf" : "-inf") + " (outputs must be finite)");
+        char value[32];
+        std::snprintf(value, sizeof value, "%g", v);
+        throw Error(where + pixel + "negative (" + value + "; outputs must be non-negative)");
+      }
+}
+
+void check_metadata(const ImageMetadata& m, const std::string& path) {
+  const std::string where = "cannot write " + path + ": ";
+  if (!std::isfinite(m.exposure) || m.exposure <= 0)
+    throw Error(where + "exposure " + exact_text(m.exposure) + " must be finite and positive");
+  if (m.units.empty() || !printable_ascii(m.units) || trailing_blank(m.units))
+    throw Error(where + "units " + quoted(m.units) +
+                " must be non-empty printable ASCII without trailing blanks");
+  std::set<std::string> seen;  // upper case: FITS keywords do not keep case
+  for (const auto& [key, value] : m.entries) {
+    if (!valid_key(key))
+      throw Error(where + "metadata key " + quoted(key) +
+                  " is not 1 to 24 characters of [A-Za-z0-9_-] starting with a letter");
+    if (reserved_key(key))
+      throw Error(where + "metadata key '" + key + "' is a name the file layouts use themselves");
+    std::string upper = key;
+    std::transform(upper.begin(), upper.end(), upper.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+    if (!seen.insert(upper).second)
+      throw Error(where + "metadata key '" + key + "' appears twice (keys are compared ignoring case)");
+    if (!printable_ascii(value) || trailing_blank(value))
+      throw Error(where + "metadata " + key + " = " + quoted(value) +
+                  " must be printable ASCII without trailing blanks");
+  }
+}
+
+// Refuses a target that is a folder, exists (unless overwrite), or whose
+// folder is missing, before anything is created.
+void check_target(const std::string& path, bool overwrite) {
+  const std::string where = "cannot write " + path + ": ";
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (fs::is_directory(status)) throw Error(where + "it is a folder");
+  if (fs::exists(status) && !overwrite)
+    throw Error(where + "the file exists (overwriting was not requested)");
+  const fs::path target(path);
+  const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  const fs::file_status folder_status = fs::status(folder, ec);
+  if (!fs::exists(folder_status)) throw Error(where + "folder " + folder.string() + " does not exist");
+  if (!fs::is_directory(folder_status)) throw Error(where + folder.string() + " is not a folder");
+}
+
+// Makes the finished file durable before the rename publishes it; returns
+// errno's text on failure.
+std::string sync_file(const std::string& file_name) {
+  const int fd = ::open(file_name.c_str(), O_WRONLY);
+  if (fd < 0) return std::strerror(errno);
+  if (::fsync(fd) != 0 && errno != EINVAL) {  // EINVAL: a file system without fsync
+    const std::string reason = std::strerror(errno);
+    ::close(fd);
+    return reason;
+  }
+  if (::close(fd) != 0) return std::strerror(errno);
+  return {};
+}
+
+// An empty file PATH.tmp-PID-N beside the target, removed again unless
+// committed. The counter keeps two threads writing the same target apart.
+class TemporaryFile {
+ public:
+  explicit TemporaryFile(const std::string& target) {
+    static std::atomic<unsigned> counter{0};
+    path_ = target + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+    // Creating it ourselves gives errno's plain reason ("Permission denied")
+    // rather than whatever the format library would make of it.
+    const int fd = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
+    if (fd < 0) {
+      committed_ = true;  // nothing was created, so nothing to remove
+      throw Error("cannot write " + target + ": " + std::strerror(errno));
+    }
+    ::close(fd);
+  }
+  ~TemporaryFile() {
+    if (!committed_) {
+      std::error_code ignored;
+      fs::remove(path_, ignored);
+    }
+  }
+  TemporaryFile(const TemporaryFile&) = delete;
+  TemporaryFile& operator=(const TemporaryFile&) = delete;
+  const std::string& path() const { return path_; }
+  void commit() { committed_ = true; }
+
+ private:
+  std::string path_;
+  bool committed_ = false;
+};
+
+}  // namespace
+
+void write_image(const Image& image, const std::string& path, const ImageMetadata& metadata,
+                 bool overwrite) {
+  Format format{};
+  if (!format_of(path, format))
+    throw Error("cannot write " + path + ": unknown image extension " + extension_of(path) +
+                " (expected " + kAccepted + ")");
+  if ((format == Format::Exr || format == Format::Png) && !openimageio_available())
+    throw Error("cannot write " + path + ": " + (format == Format::Exr ? ".exr" : ".png") +
+                " output needs OpenImageIO; this build has none (configure with "
+                "-DNEBULA_OPENIMAGEIO=ON), use .h5 or .fits");
+  check_image(image, path, format);
+  check_metadata(metadata, path);
+  check_target(path, overwrite);
+
+  TemporaryFile temporary(path);
+  try {
+    switch (format) {
+      case Format::Hdf5: write_hdf5(image, metadata, temporary.path()); break;
+      case Format::Fits: write_fits(image, metadata, temporary.path()); break;
+      case Format::Exr: write_exr(image, metadata, temporary.path()); break;
+      case Format::Png: write_png(image, metadata, temporary.path()); break;
+    }
+  } catch (const Error& e) {
+    throw Error("cannot write " + path + ": " + e.what());
+  } catch (const std::bad_alloc&) {
+    throw Error("cannot write " + path + ": out of memory");
+  }
+  const std::string failure = sync_file(temporary.path());
+  if (!failure.empty()) throw Error("cannot write " + path + ": " + failure);
+  // rename() replaces atomically; the existence check above has a small race
+  // with other writers, acceptable for files made by one run at a time.
+  std::error_code ec;
+  fs::rename(temporary.path(), path, ec);
+  if (ec) throw Error("cannot write " + path + ": renaming the temporary file failed: " + ec.message());
+  temporary.commit();
+}
+
+Image read_image(const std::string& path, ImageMetadata* metadata) {
+  Format format{};
+  if (!format_of(path, format))
+    throw Error(path + ": cannot read: unknown image extension " + extension_of(path) +
+                " (expected .h5, .fits, .fit or .exr)");
+  if (format == Format::Png)
+    throw Error(path + ": cannot read: a PNG is a tone-mapped 8-bit picture, not data; read the "
+                ".h5, .fits or .exr");
+  if (format == Format::Exr && !openimageio_available())
+    throw Error(path + ": cannot read: .exr needs OpenImageIO; this build has none (configure "
+                "with -DNEBULA_OPENIMAGEIO=ON)");
+
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (!fs::exists(status)) throw Error(path + ": cannot read: no such file");
+  if (fs::is_directory(status)) throw Error(path + ": cannot read: it is a folder");
+  if (std::FILE* probe = std::fopen(path.c_str(), "rb")) {
+    std::fclose(probe);
+  } else {
+    throw Error(path + ": cannot read: " + std::strerror(errno));
+  }
+
+  ImageMetadata read_metadata;
+  Image image;
+  try {
+    switch (format) {
+      case Format::Hdf5: image = read_hdf5(path, &read_metadata); break;
+      case Format::Fits: image = read_fits(path, &read_metadata); break;
+      case Format::Exr: image = read_exr(path, &read_metadata); break;
+      case Format::Png: break;  // refused above
+    }
+  } catch (const std::bad_alloc&) {
+    throw Error(path + ": out of memory while reading the image");
+  }
+
+  // What every format must give back: distinct, well-formed band names and
+  // finite pixels.
+  std::set<std::string> seen;
+  for (const std::string& band : image.bands)
+    if (!valid_band_name(band) || !seen.insert(band).second)
+      fail(path, "bands", "distinct names of 1 to 32 characters of [A-Za-z0-9_.+-]",
+           quoted(join_bands(image.bands)));
+  for (size_t b = 0; b < image.bands.size(); ++b)
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x)
+        if (!std::isfinite(image.at(static_cast<int>(b), x, y)))
+          fail(path, "pixels", "finite values",
+               "a non-finite value in band " + image.bands[b] + " at (x " + std::to_string(x) +
+                   ", y " + std::to_string(y) + ")");
+  if (metadata != nullptr) *metadata = read_metadata;
+  return image;
+}
+
+}  // namespace nebula

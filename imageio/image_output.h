@@ -1,0 +1,45 @@
+#pragma once
+// Rendered images to and from files (DESIGN.md section 4): linear float per
+// band to HDF5, FITS and EXR, tone-mapped sRGB to PNG. Layouts, orientation
+// and the tone curve are in imageio/README.md.
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/image.h"
+
+namespace nebula {
+
+// What a file says besides its pixels. Keys are 1 to 24 characters of
+// [A-Za-z0-9_-] starting with a letter, unique ignoring case (FITS keywords
+// are upper case) and not one of the names the layouts use themselves;
+// values are printable ASCII without trailing blanks (FITS headers are ASCII
+// and drop trailing blanks), units the same and not empty. Within these
+// rules every format gives back exactly what was written.
+struct ImageMetadata {
+  std::string units = "arbitrary";
+  std::vector<std::pair<std::string, std::string>> entries;  // e.g. {"albedo_B", "0.6"}
+  double exposure = 1.0;  // PNG: scale applied before tone mapping; stored as a hint elsewhere
+  double gamma = 2.2;     // unused by the writers: PNG uses the sRGB curve (README)
+};
+
+// Writes IMAGE to PATH in the format its extension names: .h5, .fits or
+// .fit, .exr, .png (the last two only when built with OpenImageIO). Refuses,
+// with one line naming the path and the reason and before touching the
+// disk: an unknown extension, a malformed image or metadata, a NaN,
+// infinite or negative pixel, a missing folder, an existing file unless
+// `overwrite`. The file is written to a temporary name beside PATH and
+// renamed into place, so no half-written file is ever seen or left behind.
+void write_image(const Image& image, const std::string& path, const ImageMetadata& metadata,
+                 bool overwrite);
+
+// Reads an image written by write_image (.h5, .fits/.fit, and .exr with
+// OpenImageIO), filling *metadata when given (gamma is not stored and stays
+// at its default). Refuses missing, foreign, truncated or malformed files and
+// non-finite pixels with one line naming the file and the field.
+Image read_image(const std::string& path, ImageMetadata* metadata = nullptr);
+
+// Whether this build has OpenImageIO, and so .exr and .png.
+bool openimageio_available();
+
+}  // namespace nebula

@@ -1,0 +1,209 @@
+#include "scene/scene.h"
+
+#include <cmath>
+#include <cstdio>
+#include <set>
+
+#include "core/error.h"
+#include "illumination/star.h"
+#include "scene/density_sources.h"
+#include "scene/scene_checks.h"
+
+namespace nebula {
+
+const char* to_string(CameraKind kind) {
+  switch (kind) {
+    case CameraKind::Perspective: return "perspective";
+    case CameraKind::Orthographic: return "orthographic";
+    case CameraKind::Fisheye: return "fisheye";
+  }
+  return "unknown";
+}
+
+namespace scene_detail {
+namespace {
+
+bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+std::string vec_text(Vec3 v) {
+  std::string text = "[";
+  text += number_text(v.x) + ", " + number_text(v.y) + ", " + number_text(v.z) + "]";
+  return text;
+}
+
+bool all_equal(const std::vector<double>& v) {
+  for (double x : v)
+    if (!(x == v.front())) return false;
+  return true;
+}
+
+// Checks one per-band dust quantity; the key is "dust.<name>" when every band
+// has the same value (one number in the file) and "dust.<name>.<band>" otherwise.
+template <class Good>
+std::optional<SceneIssue> per_band_issue(const Scene& s, const std::vector<double>& values,
+                                         const std::string& name, const std::string& range,
+                                         Good good) {
+  if (values.size() != s.bands.size())
+    return SceneIssue{"dust." + name, "has " + std::to_string(values.size()) + " values for " +
+                                          std::to_string(s.bands.size()) + " bands"};
+  for (size_t b = 0; b < values.size(); ++b)
+    if (!(std::isfinite(values[b]) && good(values[b])))
+      return SceneIssue{all_equal(values) ? "dust." + name : "dust." + name + "." + s.bands[b],
+                        "is " + number_text(values[b]) + "; must be " + range};
+  return std::nullopt;
+}
+
+std::optional<SceneIssue> camera_issue(const CameraSpec& c) {
+  if (!finite(c.position)) return SceneIssue{"camera.position", "must be finite"};
+  if (!finite(c.look_at)) return SceneIssue{"camera.look_at", "must be finite"};
+  if (!finite(c.up)) return SceneIssue{"camera.up", "must be finite"};
+  const double dx = double(c.look_at.x) - c.position.x, dy = double(c.look_at.y) - c.position.y,
+               dz = double(c.look_at.z) - c.position.z;
+  const double view = std::sqrt(dx * dx + dy * dy + dz * dz);
+  const double scale = std::fmax(1.0, std::sqrt(double(dot(c.position, c.position))));
+  if (!(view > 1e-6 * scale))
+    return SceneIssue{"camera.look_at", "equals camera.position " + vec_text(c.position) +
+                                            ": the view direction has zero length"};
+  const double ux = c.up.x, uy = c.up.y, uz = c.up.z;
+  const double up = std::sqrt(ux * ux + uy * uy + uz * uz);
+  if (!(up > 0)) return SceneIssue{"camera.up", "must not be the zero vector"};
+  // |d x u| / (|d| |u|) = sin of the angle between them.
+  const double cx = dy * uz - dz * uy, cy = dz * ux - dx * uz, cz = dx * uy - dy * ux;
+  const double sine = std::sqrt(cx * cx + cy * cy + cz * cz) / (view * up);
+  if (!(sine > 1e-6))
+    return SceneIssue{"camera.up", "is " + vec_text(c.up) +
+                                       ", parallel to the view direction (look_at - position); "
+                                       "choose an up vector across it"};
+  if (!(std::isfinite(c.fov_deg) && c.fov_deg > 0 && c.fov_deg < 180))
+    return SceneIssue{"camera.fov_deg", "is " + number_text(c.fov_deg) + "; must be in (0, 180)"};
+  if (c.kind == CameraKind::Orthographic) {
+    if (!(std::isfinite(c.ortho_width) && c.ortho_width > 0))
+      return SceneIssue{"camera.ortho_width", "is " + number_text(c.ortho_width) +
+                                                  "; an orthographic camera needs a width "
+                                                  "(parsecs across the image) > 0"};
+  } else if (!(std::isfinite(c.ortho_width) && c.ortho_width >= 0)) {
+    return SceneIssue{"camera.ortho_width", "is " + number_text(c.ortho_width) + "; must be >= 0"};
+  }
+  if (c.width < 1) return SceneIssue{"camera.width", "is " + std::to_string(c.width) + "; must be >= 1"};
+  if (c.height < 1) return SceneIssue{"camera.height", "is " + std::to_string(c.height) + "; must be >= 1"};
+  constexpr int kMaxPixels = 1 << 16;
+  if (c.width > kMaxPixels)
+    return SceneIssue{"camera.width", "is " + std::to_string(c.width) + "; must be <= 65536"};
+  if (c.height > kMaxPixels)
+    return SceneIssue{"camera.height", "is " + std::to_string(c.height) + "; must be <= 65536"};
+  if (c.kind == CameraKind::Fisheye && c.width != c.height)
+    return SceneIssue{"camera.height", "is " + std::to_string(c.height) + " but width is " +
+                                           std::to_string(c.width) +
+                                           "; a fisheye dome master must be square"};
+  if (!(std::isfinite(c.exposure) && c.exposure > 0))
+    return SceneIssue{"camera.exposure", "is " + number_text(c.exposure) + "; must be > 0"};
+  return std::nullopt;
+}
+
+std::optional<SceneIssue> star_issue(const SceneStar& star, const std::string& key) {
+  if (!finite(star.position)) return SceneIssue{key + ".position", "must be finite"};
+  if (!(std::isfinite(star.luminosity_lsun) && star.luminosity_lsun > 0))
+    return SceneIssue{key + ".luminosity_lsun",
+                      "is " + number_text(star.luminosity_lsun) + "; must be > 0 (L_sun)"};
+  if (!(std::isfinite(star.temperature_K) && star.temperature_K > 0))
+    return SceneIssue{key + ".temperature_K",
+                      "is " + number_text(star.temperature_K) + "; must be > 0 (K)"};
+  if (!star.spectral_class.empty()) {
+    double t = 0;
+    try {
+      t = effective_temperature_K(star.spectral_class);
+    } catch (const Error& e) {
+      return SceneIssue{key + ".class", e.what()};
+    }
+    if (std::fabs(t - star.temperature_K) > kClassTemperatureTolerance)
+      return SceneIssue{key + ".temperature_K",
+                        "is " + number_text(star.temperature_K) + " K but class '" +
+                            star.spectral_class + "' has " + number_text(t) +
+                            " K (Pecaut & Mamajek 2013); give one of them, or both agreeing"};
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::string number_text(double v) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
+
+bool known_band(const std::string& band) { return band == "B" || band == "V" || band == "R"; }
+
+std::optional<SceneIssue> settings_issue(const Scene& s) {
+  if (s.bands.empty()) return SceneIssue{"bands", "must name at least one band"};
+  std::set<std::string> seen;
+  for (const std::string& band : s.bands) {
+    if (!known_band(band))
+      return SceneIssue{"bands", "'" + band + "' is not a known band (known: B, V, R)"};
+    if (!seen.insert(band).second) return SceneIssue{"bands", "'" + band + "' appears twice"};
+  }
+  if (auto issue = per_band_issue(s, s.dust.albedo, "albedo", "in [0, 1]",
+                                  [](double a) { return a >= 0 && a <= 1; }))
+    return issue;
+  if (auto issue = per_band_issue(s, s.dust.g, "g", "in (-1, 1)",
+                                  [](double g) { return std::fabs(g) < 1; }))
+    return issue;
+  if (!(std::isfinite(s.dust.R_V) && s.dust.R_V >= kMinRV && s.dust.R_V <= kMaxRV))
+    return SceneIssue{"dust.R_V", "is " + number_text(s.dust.R_V) + "; must be in [" +
+                                      number_text(kMinRV) + ", " + number_text(kMaxRV) +
+                                      "], where the extinction law holds"};
+  if (!s.dust.table_files.empty() && s.dust.table_files.size() != s.bands.size())
+    return SceneIssue{"dust.tables", "has " + std::to_string(s.dust.table_files.size()) +
+                                         " entries for " + std::to_string(s.bands.size()) +
+                                         " bands"};
+  for (size_t i = 0; i < s.stars.size(); ++i)
+    if (auto issue = star_issue(s.stars[i], "stars." + std::to_string(i))) return issue;
+  if (auto issue = camera_issue(s.camera)) return issue;
+  if (s.output.empty()) return SceneIssue{"output.file", "must not be empty"};
+  if (!(std::isfinite(s.star_psf_pixels) && s.star_psf_pixels > 0 && s.star_psf_pixels <= 1000))
+    return SceneIssue{"output.star_psf_pixels",
+                      "is " + number_text(s.star_psf_pixels) + "; must be in (0, 1000]"};
+  return std::nullopt;
+}
+
+std::optional<SceneIssue> grids_issue(const Scene& s) {
+  const GridShape& g = s.density.shape;
+  if (g.nx < 1 || g.ny < 1 || g.nz < 1)
+    return SceneIssue{"density", "the grid has a zero size (" + std::to_string(g.nx) + " x " +
+                                     std::to_string(g.ny) + " x " + std::to_string(g.nz) + ")"};
+  if (!(std::isfinite(g.voxel) && g.voxel > 0))
+    return SceneIssue{"density", "voxel size " + number_text(g.voxel) + " must be > 0"};
+  if (!finite(g.origin)) return SceneIssue{"density", "the grid origin must be finite"};
+  try {
+    check_grid_values("tau_v", g, s.density.tau_v);
+  } catch (const Error& e) {
+    return SceneIssue{"density", e.what()};
+  }
+  if (!s.emission.empty()) {
+    if (s.emission.size() != s.bands.size())
+      return SceneIssue{"emission", "has " + std::to_string(s.emission.size()) + " grids for " +
+                                        std::to_string(s.bands.size()) + " bands"};
+    for (size_t b = 0; b < s.emission.size(); ++b) {
+      try {
+        check_grid_values("emission " + s.bands[b], g, s.emission[b], "emission");
+      } catch (const Error& e) {
+        return SceneIssue{"emission", e.what()};
+      }
+    }
+  }
+  if (s.stars.empty() && s.emission.empty())
+    return SceneIssue{"stars", "the scene has no stars and no emission: nothing would shine"};
+  return std::nullopt;
+}
+
+}  // namespace scene_detail
+
+void validate_scene(const Scene& scene) {
+  const std::string name = scene.path.empty() ? "scene" : scene.path;
+  if (auto issue = scene_detail::settings_issue(scene))
+    throw Error(name + ": " + issue->key + ": " + issue->reason);
+  if (auto issue = scene_detail::grids_issue(scene))
+    throw Error(name + ": " + issue->key + ": " + issue->reason);
+}
+
+}  // namespace nebula

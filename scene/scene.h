@@ -1,0 +1,74 @@
+#pragma once
+// The scene model the renderer consumes: density (and optional emission)
+// grids, dust parameters per band, stars, one camera and the output. Built
+// by load_scene (scene/scene_file.h) from a TOML file, or by demo_scene().
+//
+// Units (docs/scene.md): lengths in parsecs (grid origin and voxel edge,
+// star positions, camera); luminosity in solar luminosities; temperatures in
+// K. Rendered radiance is in L_sun pc^-2 sr^-1 per band times `exposure`, a
+// relative scale (no distance to the observer, no detector).
+#include <string>
+#include <vector>
+
+#include "core/grid.h"
+#include "core/vec3.h"
+#include "illumination/extinction.h"
+
+namespace nebula {
+
+// Dust optical properties, one entry per scene band (Scene::bands order).
+struct DustParams {
+  std::vector<double> albedo;  // a_b in [0, 1]; default 0.6 in every band
+  std::vector<double> g;       // HG asymmetry g_b, |g| < 1; default 0.6
+  double R_V = 5.0;            // total-to-selective extinction, [2, 6]
+  ExtinctionLaw law = ExtinctionLaw::CCM89;
+  // Scattering table file per band; an empty string means "generate on first
+  // use and cache by (albedo, g)" (done by the renderer, not here). Non-empty
+  // names are resolved against the scene file's folder and exist.
+  std::vector<std::string> table_files;
+};
+
+struct SceneStar {
+  std::string name;
+  Vec3 position;           // parsecs, same frame as the grid
+  double luminosity_lsun;  // bolometric, L_sun, > 0
+  double temperature_K;    // effective temperature; from spectral_class if given
+  std::string spectral_class;  // as written in the scene ("" when only a temperature was given)
+};
+
+enum class CameraKind { Perspective, Orthographic, Fisheye };
+
+const char* to_string(CameraKind kind);  // "perspective", "orthographic", "fisheye"
+
+struct CameraSpec {
+  CameraKind kind = CameraKind::Perspective;
+  Vec3 position, look_at, up{0, 0, 1};
+  double fov_deg = 40;     // perspective: full vertical field of view, (0, 180)
+  double ortho_width = 0;  // orthographic: world units (pc) across the image width, > 0
+  int width = 512, height = 512;  // pixels; fisheye (180 deg dome master) needs width == height
+  double exposure = 1.0;          // radiance multiplier, > 0
+};
+
+struct Scene {
+  std::string path;  // the scene file as given ("demo" for demo_scene())
+  std::vector<std::string> bands{"B", "V", "R"};
+  DensityGrid density;  // tau_v per voxel
+  // Empty, or one grid per band (bands order) with the density's shape: the
+  // radiance j a ray gains crossing the voxel along one voxel edge
+  // (L_sun pc^-2 sr^-1; DESIGN.md section 3).
+  std::vector<std::vector<float>> emission;
+  DustParams dust;
+  std::vector<SceneStar> stars;
+  CameraSpec camera;
+  std::string output = "nebula.exr";  // as written; relative to the working directory
+  bool draw_stars = false;
+  double star_psf_pixels = 1.5;  // Gaussian sigma of a drawn star, pixels
+};
+
+// Checks a Scene built in code (load_scene checks the same rules and more):
+// bands, per-band vector sizes, albedo, g, R_V, stars, camera, output, grid
+// shape, emission sizes and values. Throws Error "<scene.path>: <key>: <reason>"
+// with the key named as in the scene file.
+void validate_scene(const Scene& scene);
+
+}  // namespace nebula

@@ -1,0 +1,687 @@
+#include "scene/scene_file.h"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cstring>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <string_view>
+#include <utility>
+
+#include "core/error.h"
+#include "illumination/star.h"
+#include "scene/scene_checks.h"
+
+namespace nebula {
+namespace {
+
+namespace fs = std::filesystem;
+using scene_detail::number_text;
+
+std::string join(const std::string& path, const std::string& key) {
+  return path.empty() ? key : path + "." + key;
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string one_line(std::string s) {
+  std::replace(s.begin(), s.end(), '\n', ' ');
+  std::replace(s.begin(), s.end(), '\r', ' ');
+  return s;
+}
+
+const char* type_name(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a float";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::date: return "a date";
+    case toml::node_type::time: return "a time";
+    case toml::node_type::date_time: return "a date-time";
+    default: return "nothing";
+  }
+}
+
+// The keys of every table in a scene file.
+const std::initializer_list<std::string_view> kTopKeys = {"bands",  "density", "emission", "dust",
+                                                          "stars",  "camera",  "output"};
+const std::initializer_list<std::string_view> kDensityKeys = {
+    "file", "dataset", "fits", "voxel_size_pc", "procedural", "scale"};
+const std::initializer_list<std::string_view> kProceduralKeys = {
+    "n",             "size_pc",         "origin_pc",       "seed",           "star",
+    "wind_direction", "bubble_offset",  "bubble_radius",   "bubble_tau",     "shell_thickness",
+    "shell_tau",     "cloud_tau",       "scale_length",    "near_side",      "far_multiplier",
+    "far_transition", "noise_amplitude", "noise_frequency", "noise_octaves", "noise_gain",
+    "noise_lacunarity"};
+const std::initializer_list<std::string_view> kEmissionKeys = {"file", "prefix"};
+const std::initializer_list<std::string_view> kDustKeys = {"albedo", "g", "R_V", "law", "tables"};
+const std::initializer_list<std::string_view> kStarKeys = {"name", "position", "luminosity_lsun",
+                                                           "temperature_K", "class"};
+const std::initializer_list<std::string_view> kCameraKeys = {
+    "kind", "position", "look_at", "up", "fov_deg", "ortho_width", "width", "height", "exposure"};
+const std::initializer_list<std::string_view> kOutputKeys = {"file", "draw_stars",
+                                                             "star_psf_pixels"};
+
+enum class DensityKind { Hdf5, Fits, Procedural };
+
+struct DensityPlan {
+  DensityKind kind = DensityKind::Procedural;
+  std::string key;   // "density.file", "density.fits" or "density.procedural"
+  std::string path;  // resolved file
+  std::string dataset = "tau_v";
+  double voxel_size_pc = 0;
+  ProceduralParams procedural;
+  double scale = 1;
+};
+
+struct EmissionPlan {
+  std::string path, prefix = "emission_";
+};
+
+class Parser {
+ public:
+  Parser(std::string name, fs::path base_dir) : name_(std::move(name)), base_(std::move(base_dir)) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
+    std::string message = name_ + ": " + key + ": " + reason;
+    // The latest override touching this key (or a table around or inside it).
+    for (auto it = overrides_.rbegin(); it != overrides_.rend(); ++it) {
+      const std::string& k = it->first;
+      const bool related = k == key || key.rfind(k + ".", 0) == 0 || k.rfind(key + ".", 0) == 0;
+      if (related) {
+        message += " (set by override '" + it->second + "')";
+        break;
+      }
+    }
+    throw Error(one_line(message));
+  }
+
+  void apply_override(toml::table& root, const std::string& text);
+  Scene build(toml::table& root);
+
+ private:
+  // ------------------------------------------------ typed access
+
+  void known_keys(const toml::table& t, const std::string& path,
+                  std::initializer_list<std::string_view> keys) const {
+    for (auto&& [k, v] : t) {
+      (void)v;
+      const std::string_view name = k.str();
+      if (std::find(keys.begin(), keys.end(), name) != keys.end()) continue;
+      std::string list;
+      for (std::string_view known : keys) list += (list.empty() ? "" : ", ") + std::string(known);
+      fail(join(path, std::string(name)), "unknown key (known here: " + list + ")");
+    }
+  }
+
+  const toml::table& table_at(const toml::node& n, const std::string& key) const {
+    if (!n.is_table()) fail(key, std::string("must be a table, got ") + type_name(n));
+    return *n.as_table();
+  }
+
+  double number(const toml::node& n, const std::string& key) const {
+    double v;
+    if (n.is_integer())
+      v = static_cast<double>(n.as_integer()->get());
+    else if (n.is_floating_point())
+      v = n.as_floating_point()->get();
+    else
+      fail(key, std::string("must be a number, got ") + type_name(n));
+    if (!std::isfinite(v)) fail(key, "must be finite, got " + number_text(v));
+    return v;
+  }
+
+  int64_t integer(const toml::node& n, const std::string& key) const {
+    if (!n.is_integer()) fail(key, std::string("must be an integer, got ") + type_name(n));
+    return n.as_integer()->get();
+  }
+
+  int small_integer(const toml::node& n, const std::string& key) const {
+    const int64_t v = integer(n, key);
+    if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())
+      fail(key, "is " + std::to_string(v) + ", out of range");
+    return static_cast<int>(v);
+  }
+
+  bool boolean(const toml::node& n, const std::string& key) const {
+    if (!n.is_boolean()) fail(key, std::string("must be true or false, got ") + type_name(n));
+    return n.as_boolean()->get();
+  }
+
+  std::string string(const toml::node& n, const std::string& key) const {
+    if (!n.is_string()) fail(key, std::string("must be a string, got ") + type_name(n));
+    return n.as_string()->get();
+  }
+
+  Vec3 vec3(const toml::node& n, const std::string& key) const {
+    const toml::array* a = n.as_array();
+    if (a == nullptr || a->size() != 3)
+      fail(key, std::string("must be an array of 3 numbers [x, y, z], got ") +
+                    (a ? "an array of " + std::to_string(a->size()) : std::string(type_name(n))));
+    double c[3];
+    for (int i = 0; i < 3; ++i) {
+      c[i] = number((*a)[size_t(i)], key + "[" + std::to_string(i) + "]");
+      if (std::fabs(c[i]) > 1e30) fail(key, "component " + number_text(c[i]) + " is too large");
+    }
+    return Vec3{float(c[0]), float(c[1]), float(c[2])};
+  }
+
+  // A data file named by `key`, resolved against the scene's folder.
+  std::string data_path(const toml::node& n, const std::string& key) const {
+    const std::string text = string(n, key);
+    if (text.empty()) fail(key, "must name a file");
+    fs::path p(text);
+    if (p.is_relative()) p = base_ / p;
+    return p.lexically_normal().string();
+  }
+
+  // One value for every band, or a table {B = .., V = .., R = ..} naming each band.
+  std::vector<double> per_band(const toml::node& n, const std::string& key,
+                               const std::vector<std::string>& bands) const {
+    if (!n.is_table()) return std::vector<double>(bands.size(), number(n, key));
+    const toml::table& t = *n.as_table();
+    for (auto&& [k, v] : t) {
+      (void)v;
+      const std::string band(k.str());
+      if (std::find(bands.begin(), bands.end(), band) == bands.end())
+        fail(join(key, band), "unknown band (the scene's bands: " + band_list(bands) + ")");
+    }
+    std::vector<double> values;
+    for (const std::string& band : bands) {
+      const toml::node* v = t.get(band);
+      if (v == nullptr) fail(join(key, band), "missing: a per-band table must give every band");
+      values.push_back(number(*v, join(key, band)));
+    }
+    return values;
+  }
+
+  static std::string band_list(const std::vector<std::string>& bands) {
+    std::string list;
+    for (const std::string& b : bands) list += (list.empty() ? "" : ", ") + b;
+    return list;
+  }
+
+  // ------------------------------------------------ sections
+
+  std::vector<std::string> parse_bands(const toml::table& root) const;
+  DensityPlan parse_density(const toml::table& root) const;
+  ProceduralParams parse_procedural(const toml::table& t, const std::string& key) const;
+  std::optional<EmissionPlan> parse_emission(const toml::table& root) const;
+  DustParams parse_dust(const toml::table& root, const std::vector<std::string>& bands) const;
+  std::vector<SceneStar> parse_stars(const toml::table& root, const DensityPlan& density) const;
+  CameraSpec parse_camera(const toml::table& root) const;
+  void parse_output(const toml::table& root, Scene& scene) const;
+  void load_grids(const DensityPlan& density, const std::optional<EmissionPlan>& emission,
+                  Scene& scene) const;
+
+  std::string name_;
+  fs::path base_;
+  std::vector<std::pair<std::string, std::string>> overrides_;  // key path, "KEY=VALUE"
+};
+
+// ------------------------------------------------------------ overrides
+
+void Parser::apply_override(toml::table& root, const std::string& text) {
+  const size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw Error(one_line(name_ + ": override '" + text + "': expected KEY=VALUE (e.g. camera.fov_deg=30)"));
+  const std::string key = text.substr(0, eq), value = text.substr(eq + 1);
+  std::vector<std::string> parts;
+  for (size_t begin = 0;;) {
+    const size_t dot = key.find('.', begin);
+    parts.push_back(key.substr(begin, dot == std::string::npos ? std::string::npos : dot - begin));
+    if (dot == std::string::npos) break;
+    begin = dot + 1;
+  }
+  for (const std::string& part : parts)
+    if (part.empty() || part.find_first_of(" \t\"'[]") != std::string::npos)
+      throw Error(name_ + ": override '" + text + "': bad key '" + key +
+                  "' (dotted names and 0-based indices, e.g. stars.0.luminosity_lsun)");
+  if (value.find_first_of("\n\r") != std::string::npos)
+    throw Error(name_ + ": override '" + key + "': the value must be one line");
+  overrides_.emplace_back(key, text);
+
+  // The value as TOML; text that is not a TOML value is a string.
+  toml::table holder;
+  try {
+    const std::string document = "v = " + value;
+    holder = toml::parse(std::string_view(document), std::string_view("override"));
+  } catch (const toml::parse_error&) {
+    holder = toml::table{};
+    holder.insert_or_assign("v", value);
+  }
+  toml::node& parsed = *holder.get("v");
+
+  toml::node* here = &root;
+  std::string path;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    const std::string& part = parts[i];
+    const bool last = i + 1 == parts.size();
+    const std::string at = join(path, part);
+    if (toml::table* t = here->as_table()) {
+      if (last) {
+        parsed.visit([&](auto& v) { t->insert_or_assign(part, std::move(v)); });
+        return;
+      }
+      toml::node* next = t->get(part);
+      if (next == nullptr) {
+        t->insert_or_assign(part, toml::table{});
+        next = t->get(part);
+      }
+      here = next;
+    } else if (toml::array* a = here->as_array()) {
+      if (part.find_first_not_of("0123456789") != std::string::npos)
+        fail(at, path + " is an array: address its elements by a 0-based index");
+      size_t index = 0;
+      try {
+        index = std::stoul(part);
+      } catch (const std::exception&) {
+        fail(at, "index out of range");
+      }
+      if (index > a->size())
+        fail(at, "index out of range: " + path + " has " + std::to_string(a->size()) +
+                     " elements (index " + std::to_string(a->size()) + " appends one)");
+      if (last) {
+        if (index == a->size())
+          parsed.visit([&](auto& v) { a->push_back(std::move(v)); });
+        else
+          parsed.visit([&](auto& v) { a->replace(a->cbegin() + std::ptrdiff_t(index), std::move(v)); });
+        return;
+      }
+      if (index == a->size()) a->push_back(toml::table{});
+      here = a->get(index);
+    } else {
+      fail(path, std::string("is ") + type_name(*here) + ", not a table: cannot set " + key);
+    }
+    path = at;
+  }
+}
+
+// ------------------------------------------------------------ sections
+
+std::vector<std::string> Parser::parse_bands(const toml::table& root) const {
+  const toml::node* n = root.get("bands");
+  if (n == nullptr) return {"B", "V", "R"};
+  const toml::array* a = n->as_array();
+  if (a == nullptr) fail("bands", std::string("must be an array of band names, got ") + type_name(*n));
+  std::vector<std::string> bands;
+  for (size_t i = 0; i < a->size(); ++i) bands.push_back(string((*a)[i], "bands[" + std::to_string(i) + "]"));
+  if (bands.empty()) fail("bands", "must name at least one band");
+  for (size_t i = 0; i < bands.size(); ++i) {
+    if (!scene_detail::known_band(bands[i]))
+      fail("bands", "'" + bands[i] + "' is not a known band (known: B, V, R)");
+    for (size_t j = 0; j < i; ++j)
+      if (bands[j] == bands[i]) fail("bands", "'" + bands[i] + "' appears twice");
+  }
+  return bands;
+}
+
+ProceduralParams Parser::parse_procedural(const toml::table& t, const std::string& key) const {
+  known_keys(t, key, kProceduralKeys);
+  ProceduralParams p;
+  auto num = [&](const char* name, double& out) {
+    if (const toml::node* n = t.get(name)) out = number(*n, join(key, name));
+  };
+  auto vec = [&](const char* name, Vec3& out) {
+    if (const toml::node* n = t.get(name)) out = vec3(*n, join(key, name));
+  };
+  auto small = [&](const char* name, int& out) {
+    if (const toml::node* n = t.get(name)) out = small_integer(*n, join(key, name));
+  };
+  small("n", p.n);
+  num("size_pc", p.size_pc);
+  vec("origin_pc", p.origin_pc);
+  if (const toml::node* n = t.get("seed")) {
+    const int64_t seed = integer(*n, join(key, "seed"));
+    if (seed < 0) fail(join(key, "seed"), "is " + std::to_string(seed) + "; must be >= 0");
+    p.seed = static_cast<uint64_t>(seed);
+  }
+  vec("star", p.star);
+  vec("wind_direction", p.wind_direction);
+  num("bubble_offset", p.bubble_offset);
+  num("bubble_radius", p.bubble_radius);
+  num("bubble_tau", p.bubble_tau);
+  num("shell_thickness", p.shell_thickness);
+  num("shell_tau", p.shell_tau);
+  num("cloud_tau", p.cloud_tau);
+  num("scale_length", p.scale_length);
+  vec("near_side", p.near_side);
+  num("far_multiplier", p.far_multiplier);
+  num("far_transition", p.far_transition);
+  num("noise_amplitude", p.noise_amplitude);
+  num("noise_frequency", p.noise_frequency);
+  small("noise_octaves", p.noise_octaves);
+  num("noise_gain", p.noise_gain);
+  num("noise_lacunarity", p.noise_lacunarity);
+  if (const auto issue = check_procedural(p)) fail(join(key, issue->parameter), issue->reason);
+  return p;
+}
+
+DensityPlan Parser::parse_density(const toml::table& root) const {
+  const toml::node* n = root.get("density");
+  if (n == nullptr)
+    fail("density", "missing required table [density] (one of file, fits or procedural)");
+  const toml::table& t = table_at(*n, "density");
+  known_keys(t, "density", kDensityKeys);
+  std::vector<std::string> given;
+  for (const char* source : {"file", "fits", "procedural"})
+    if (t.get(source) != nullptr) given.push_back(source);
+  if (given.empty()) fail("density", "give one of file (HDF5), fits or procedural");
+  if (given.size() > 1)
+    fail("density." + given[1], "conflicts with density." + given[0] +
+                                    ": give exactly one of file, fits or procedural");
+  DensityPlan plan;
+  plan.key = "density." + given[0];
+  if (given[0] == "procedural") {
+    plan.kind = DensityKind::Procedural;
+    plan.procedural = parse_procedural(table_at(*t.get("procedural"), plan.key), plan.key);
+  } else {
+    plan.kind = given[0] == "file" ? DensityKind::Hdf5 : DensityKind::Fits;
+    plan.path = data_path(*t.get(given[0]), plan.key);
+  }
+  if (const toml::node* d = t.get("dataset")) {
+    if (plan.kind != DensityKind::Hdf5) fail("density.dataset", "applies to density.file (HDF5) only");
+    plan.dataset = string(*d, "density.dataset");
+    if (plan.dataset.empty()) fail("density.dataset", "must not be empty");
+  }
+  if (const toml::node* v = t.get("voxel_size_pc")) {
+    if (plan.kind != DensityKind::Fits)
+      fail("density.voxel_size_pc",
+           "applies to density.fits only (HDF5 files carry a voxel_size attribute; "
+           "procedural grids use size_pc / n)");
+    plan.voxel_size_pc = number(*v, "density.voxel_size_pc");
+    if (!(plan.voxel_size_pc > 0))
+      fail("density.voxel_size_pc", "is " + number_text(plan.voxel_size_pc) + "; must be > 0 (parsecs)");
+  }
+  if (const toml::node* s = t.get("scale")) {
+    plan.scale = number(*s, "density.scale");
+    if (!(plan.scale > 0)) fail("density.scale", "is " + number_text(plan.scale) + "; must be > 0");
+  }
+  return plan;
+}
+
+std::optional<EmissionPlan> Parser::parse_emission(const toml::table& root) const {
+  const toml::node* n = root.get("emission");
+  if (n == nullptr) return std::nullopt;
+  const toml::table& t = table_at(*n, "emission");
+  known_keys(t, "emission", kEmissionKeys);
+  EmissionPlan plan;
+  const toml::node* file = t.get("file");
+  if (file == nullptr) fail("emission.file", "missing required key (an HDF5 file)");
+  plan.path = data_path(*file, "emission.file");
+  if (const toml::node* p = t.get("prefix")) plan.prefix = string(*p, "emission.prefix");
+  return plan;
+}
+
+DustParams Parser::parse_dust(const toml::table& root, const std::vector<std::string>& bands) const {
+  DustParams dust;
+  dust.albedo.assign(bands.size(), 0.6);
+  dust.g.assign(bands.size(), 0.6);
+  dust.table_files.assign(bands.size(), "");
+  const toml::node* n = root.get("dust");
+  if (n == nullptr) return dust;
+  const toml::table& t = table_at(*n, "dust");
+  known_keys(t, "dust", kDustKeys);
+  if (const toml::node* a = t.get("albedo")) dust.albedo = per_band(*a, "dust.albedo", bands);
+  if (const toml::node* g = t.get("g")) dust.g = per_band(*g, "dust.g", bands);
+  if (const toml::node* r = t.get("R_V")) dust.R_V = number(*r, "dust.R_V");
+  if (const toml::node* l = t.get("law")) {
+    const std::string law = string(*l, "dust.law");
+    if (lower(law) == "ccm89")
+      dust.law = ExtinctionLaw::CCM89;
+    else if (lower(law) == "odonnell94")
+      dust.law = ExtinctionLaw::ODonnell94;
+    else
+      fail("dust.law", "'" + law + "' is not a known law (known: ccm89, odonnell94)");
+  }
+  if (const toml::node* tb = t.get("tables")) {
+    const toml::table& tables = table_at(*tb, "dust.tables");
+    for (auto&& [k, v] : tables) {
+      const std::string band(k.str());
+      const auto at = std::find(bands.begin(), bands.end(), band);
+      const std::string key = "dust.tables." + band;
+      if (at == bands.end()) fail(key, "unknown band (the scene's bands: " + band_list(bands) + ")");
+      const std::string text = string(v, key);
+      if (text.empty()) continue;  // generate on first use
+      const std::string path = data_path(v, key);
+      std::ifstream probe(path, std::ios::binary);
+      if (!probe || fs::is_directory(path))
+        fail(key, "cannot read the table file '" + path + "'");
+      dust.table_files[size_t(at - bands.begin())] = path;
+    }
+  }
+  return dust;
+}
+
+std::vector<SceneStar> Parser::parse_stars(const toml::table& root, const DensityPlan& density) const {
+  std::vector<SceneStar> stars;
+  const toml::node* n = root.get("stars");
+  if (n == nullptr) return stars;
+  const toml::array* a = n->as_array();
+  if (a == nullptr)
+    fail("stars", std::string("must be an array of tables ([[stars]] sections), got ") + type_name(*n));
+  for (size_t i = 0; i < a->size(); ++i) {
+    const std::string key = "stars." + std::to_string(i);
+    const toml::table& t = table_at((*a)[i], key);
+    known_keys(t, key, kStarKeys);
+    SceneStar star;
+    star.name = "star " + std::to_string(i);
+    if (const toml::node* v = t.get("name")) star.name = string(*v, key + ".name");
+    if (const toml::node* v = t.get("position")) {
+      star.position = vec3(*v, key + ".position");
+    } else if (density.kind == DensityKind::Procedural) {
+      star.position = procedural_star_position(density.procedural);
+    } else {
+      fail(key + ".position", "missing required key (parsecs; it may be left out only with a "
+                              "procedural density, whose star it then is)");
+    }
+    const toml::node* lum = t.get("luminosity_lsun");
+    if (lum == nullptr) fail(key + ".luminosity_lsun", "missing required key (luminosity in L_sun)");
+    star.luminosity_lsun = number(*lum, key + ".luminosity_lsun");
+    if (!(star.luminosity_lsun > 0))
+      fail(key + ".luminosity_lsun", "is " + number_text(star.luminosity_lsun) + "; must be > 0");
+    const toml::node* temperature = t.get("temperature_K");
+    const toml::node* cls = t.get("class");
+    if (temperature == nullptr && cls == nullptr)
+      fail(key, "give temperature_K or class (e.g. class = \"O5V\")");
+    if (cls != nullptr) {
+      star.spectral_class = string(*cls, key + ".class");
+      try {
+        star.temperature_K = effective_temperature_K(star.spectral_class);
+      } catch (const Error& e) {
+        fail(key + ".class", e.what());
+      }
+    }
+    if (temperature != nullptr) {
+      star.temperature_K = number(*temperature, key + ".temperature_K");
+      if (!(star.temperature_K > 0))
+        fail(key + ".temperature_K", "is " + number_text(star.temperature_K) + "; must be > 0 (K)");
+    }
+    stars.push_back(star);
+  }
+  return stars;
+}
+
+CameraSpec Parser::parse_camera(const toml::table& root) const {
+  const toml::node* n = root.get("camera");
+  if (n == nullptr) fail("camera", "missing required table [camera] (position and look_at)");
+  const toml::table& t = table_at(*n, "camera");
+  known_keys(t, "camera", kCameraKeys);
+  CameraSpec c;
+  if (const toml::node* k = t.get("kind")) {
+    const std::string kind = lower(string(*k, "camera.kind"));
+    if (kind == "perspective")
+      c.kind = CameraKind::Perspective;
+    else if (kind == "orthographic")
+      c.kind = CameraKind::Orthographic;
+    else if (kind == "fisheye")
+      c.kind = CameraKind::Fisheye;
+    else
+      fail("camera.kind", "'" + string(*k, "camera.kind") +
+                              "' is not a camera kind (known: perspective, orthographic, fisheye)");
+  }
+  for (const char* required : {"position", "look_at"})
+    if (t.get(required) == nullptr)
+      fail(std::string("camera.") + required, "missing required key ([x, y, z] in parsecs)");
+  c.position = vec3(*t.get("position"), "camera.position");
+  c.look_at = vec3(*t.get("look_at"), "camera.look_at");
+  if (const toml::node* v = t.get("up")) c.up = vec3(*v, "camera.up");
+  if (const toml::node* v = t.get("fov_deg")) c.fov_deg = number(*v, "camera.fov_deg");
+  if (const toml::node* v = t.get("ortho_width")) c.ortho_width = number(*v, "camera.ortho_width");
+  else if (c.kind == CameraKind::Orthographic)
+    fail("camera.ortho_width", "missing: an orthographic camera needs the width of its view in parsecs");
+  if (const toml::node* v = t.get("width")) c.width = small_integer(*v, "camera.width");
+  if (const toml::node* v = t.get("height")) c.height = small_integer(*v, "camera.height");
+  if (const toml::node* v = t.get("exposure")) c.exposure = number(*v, "camera.exposure");
+  return c;
+}
+
+void Parser::parse_output(const toml::table& root, Scene& scene) const {
+  const toml::node* n = root.get("output");
+  if (n == nullptr) return;
+  const toml::table& t = table_at(*n, "output");
+  known_keys(t, "output", kOutputKeys);
+  if (const toml::node* v = t.get("file")) scene.output = string(*v, "output.file");
+  if (const toml::node* v = t.get("draw_stars")) scene.draw_stars = boolean(*v, "output.draw_stars");
+  if (const toml::node* v = t.get("star_psf_pixels"))
+    scene.star_psf_pixels = number(*v, "output.star_psf_pixels");
+}
+
+void Parser::load_grids(const DensityPlan& density, const std::optional<EmissionPlan>& emission,
+                        Scene& scene) const {
+  try {
+    switch (density.kind) {
+      case DensityKind::Hdf5: scene.density = load_density_hdf5(density.path, density.dataset); break;
+      case DensityKind::Fits: scene.density = load_density_fits(density.path, density.voxel_size_pc); break;
+      case DensityKind::Procedural: scene.density = procedural_nebula(density.procedural); break;
+    }
+  } catch (const Error& e) {
+    fail(density.key, e.what());
+  }
+  if (density.scale != 1) {
+    for (float& v : scene.density.tau_v) v = static_cast<float>(v * density.scale);
+    try {
+      check_grid_values("tau_v after scaling", scene.density.shape, scene.density.tau_v);
+    } catch (const Error& e) {
+      fail("density.scale", e.what());
+    }
+  }
+  if (emission) {
+    // The density and the emission grids must fit together.
+    const GridShape& s = scene.density.shape;
+    try {
+      check_grid_size("density and " + std::to_string(scene.bands.size()) + " emission grids",
+                      uint64_t(s.nx), uint64_t(s.ny), uint64_t(s.nz),
+                      sizeof(float) * (1 + scene.bands.size()));
+      for (const std::string& band : scene.bands)
+        scene.emission.push_back(load_emission_hdf5(emission->path, emission->prefix + band, s));
+    } catch (const Error& e) {
+      fail("emission.file", e.what());
+    }
+  }
+}
+
+Scene Parser::build(toml::table& root) {
+  known_keys(root, "", kTopKeys);
+  Scene scene;
+  scene.path = name_;
+  scene.bands = parse_bands(root);
+  const DensityPlan density = parse_density(root);
+  const std::optional<EmissionPlan> emission = parse_emission(root);
+  scene.dust = parse_dust(root, scene.bands);
+  scene.stars = parse_stars(root, density);
+  if (scene.stars.empty() && !emission)
+    fail("stars", "missing: a scene needs at least one [[stars]] entry (or an [emission] grid)");
+  scene.camera = parse_camera(root);
+  parse_output(root, scene);
+  if (const auto issue = scene_detail::settings_issue(scene)) fail(issue->key, issue->reason);
+  load_grids(density, emission, scene);  // the expensive part, last
+  if (const auto issue = scene_detail::grids_issue(scene)) fail(issue->key, issue->reason);
+  return scene;
+}
+
+Scene parse_scene(const std::string& text, const std::string& name, const fs::path& base,
+                  const std::vector<std::string>& overrides) {
+  toml::table root;
+  try {
+    root = toml::parse(std::string_view(text), std::string_view(name));
+  } catch (const toml::parse_error& e) {
+    const auto& where = e.source().begin;
+    throw Error(one_line(name + ":" + std::to_string(where.line) + ":" +
+                         std::to_string(where.column) + ": TOML syntax: " +
+                         std::string(e.description())));
+  }
+  Parser parser(name, base);
+  for (const std::string& o : overrides) parser.apply_override(root, o);
+  return parser.build(root);
+}
+
+}  // namespace
+
+Scene load_scene_text(const std::string& text, const std::string& name, const std::string& base_dir,
+                      const std::vector<std::string>& overrides) {
+  return parse_scene(text, name, fs::path(base_dir), overrides);
+}
+
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    const int err = errno;
+    throw Error(path + ": cannot read the scene file (" + std::strerror(err ? err : ENOENT) + ")");
+  }
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw Error(path + ": cannot read the scene file (a directory)");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw Error(path + ": cannot read the scene file");
+  return parse_scene(text.str(), path, fs::path(path).parent_path(), overrides);
+}
+
+ProceduralParams demo_procedural_params() { return ProceduralParams{}; }
+
+Scene demo_scene() {
+  Scene scene;
+  scene.path = "demo";
+  const ProceduralParams params = demo_procedural_params();
+  scene.density = procedural_nebula(params);
+  scene.dust.albedo.assign(scene.bands.size(), 0.6);
+  scene.dust.g.assign(scene.bands.size(), 0.6);
+  scene.dust.R_V = 5.0;
+  scene.dust.law = ExtinctionLaw::CCM89;
+  scene.dust.table_files.assign(scene.bands.size(), "");
+  SceneStar star;
+  star.name = "O5V star";
+  star.position = procedural_star_position(params);
+  star.luminosity_lsun = 2e5;
+  star.spectral_class = "O5V";
+  star.temperature_K = effective_temperature_K("O5V");
+  scene.stars.push_back(star);
+  scene.camera.kind = CameraKind::Perspective;
+  scene.camera.position = Vec3{1.0f, -2.5f, 1.3f};
+  scene.camera.look_at = star.position;
+  scene.camera.up = Vec3{0, 0, 1};
+  scene.camera.fov_deg = 40;
+  scene.camera.width = scene.camera.height = 512;
+  scene.camera.exposure = 0.02;  // maps the 99th percentile of B to about 0.8 in a PNG
+  scene.output = "demo.exr";
+  scene.draw_stars = false;
+  scene.star_psf_pixels = 1.5;
+  validate_scene(scene);
+  return scene;
+}
+
+}  // namespace nebula

@@ -1,0 +1,35 @@
+#pragma once
+// Scene files: TOML (docs/scene.md documents every key), read with toml++.
+#include <string>
+#include <vector>
+
+#include "scene/density_sources.h"
+#include "scene/scene.h"
+
+namespace nebula {
+
+// Reads, overrides, checks and loads a scene: the density (and emission)
+// grids are read or generated here. `overrides` are "KEY=VALUE" strings
+// applied in order to the parsed file before any check: KEY is a dotted path
+// (camera.fov_deg, dust.albedo.B, density.procedural.seed), with array
+// elements addressed by a 0-based index (stars.0.luminosity_lsun; the index
+// one past the end appends a star); VALUE is a TOML value (30, 1e4, true,
+// [1, 2, 3], {B = 0.7, V = 0.6, R = 0.5}, "text"), and text that is not valid
+// TOML is taken as a string (camera.kind=fisheye). Every problem is an Error
+// of one line, "<file>: <key>: <reason>", with "(set by override 'K=V')"
+// appended when an override supplied the key.
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
+
+// The same, from TOML text; `name` stands for the file in messages and
+// `base_dir` resolves relative data paths.
+Scene load_scene_text(const std::string& text, const std::string& name,
+                      const std::string& base_dir, const std::vector<std::string>& overrides = {});
+
+// The built-in demo (`nebula render --demo`), equal to scenes/demo.toml: the
+// default procedural nebula (128^3 voxels, 2 pc), one O5V star of 2e5 L_sun
+// at the procedural star, a 512 x 512 perspective camera 3.5 pc away on the
+// near side (-y) looking at the star, dust a = g = 0.6, R_V = 5 (CCM89).
+ProceduralParams demo_procedural_params();
+Scene demo_scene();
+
+}  // namespace nebula

@@ -1,0 +1,534 @@
+#include "scene/scene_file.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "illumination/star.h"
+#include "scene/test_files.h"
+
+namespace nebula {
+namespace {
+
+using testing::expect_error;
+using testing::H5Dataset;
+using testing::write_fits;
+using testing::write_h5;
+
+// A small valid scene; the refusal tests edit it one line at a time.
+const char* kBase = R"(
+[density]
+procedural = { n = 16, size_pc = 2.0, seed = 3 }
+
+[dust]
+albedo = 0.6
+g = 0.6
+R_V = 5.0
+
+[[stars]]
+name = "HD 1"
+position = [1.0, 1.0, 1.0]
+luminosity_lsun = 2e5
+class = "O5V"
+
+[camera]
+position = [1.0, -3.0, 1.0]
+look_at = [1.0, 1.0, 1.0]
+
+[output]
+file = "out.exr"
+)";
+
+// kBase with the first occurrence of `from` replaced by `to` (which must exist).
+std::string edited(const std::string& from, const std::string& to) {
+  std::string text = kBase;
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+class SceneFile : public testing::TempDirTest {
+ protected:
+  // Writes the text as <name>.toml and expects load_scene to refuse it with a
+  // message naming the file and every piece.
+  void refused(const std::string& name, const std::string& text, std::vector<std::string> pieces,
+               const std::vector<std::string>& overrides = {}) {
+    const std::string file = write_text(name + ".toml", text);
+    pieces.insert(pieces.begin(), name + ".toml");
+    SCOPED_TRACE(name);
+    expect_error([&] { load_scene(file, overrides); }, pieces);
+  }
+
+  // A 4 x 3 x 2 HDF5 density with voxel 0.5 pc; `bad` replaces voxel (1, 2, 1).
+  void density_file(const std::string& name, std::optional<double> bad = std::nullopt) {
+    H5Dataset set;
+    set.dims = {2, 3, 4};
+    set.values.assign(24, 0.25);
+    if (bad) set.values[21] = *bad;
+    set.voxel_size = 0.5;
+    write_h5(path(name), {set});
+  }
+};
+
+TEST_F(SceneFile, BaseSceneLoadsWithDefaults) {
+  const Scene s = load_scene(write_text("base.toml", kBase));
+  EXPECT_EQ(s.path, path("base.toml"));
+  EXPECT_EQ(s.bands, (std::vector<std::string>{"B", "V", "R"}));
+  EXPECT_EQ(s.density.shape.nx, 16);
+  EXPECT_FLOAT_EQ(s.density.shape.voxel, 0.125f);
+  EXPECT_TRUE(s.emission.empty());
+  EXPECT_EQ(s.dust.albedo, std::vector<double>(3, 0.6));
+  EXPECT_EQ(s.dust.g, std::vector<double>(3, 0.6));
+  EXPECT_EQ(s.dust.R_V, 5.0);
+  EXPECT_EQ(s.dust.law, ExtinctionLaw::CCM89);
+  EXPECT_EQ(s.dust.table_files, std::vector<std::string>(3, ""));
+  ASSERT_EQ(s.stars.size(), 1u);
+  EXPECT_EQ(s.stars[0].name, "HD 1");
+  EXPECT_EQ(s.stars[0].temperature_K, 41400.0);
+  EXPECT_EQ(s.stars[0].spectral_class, "O5V");
+  EXPECT_EQ(s.stars[0].luminosity_lsun, 2e5);
+  EXPECT_EQ(s.camera.kind, CameraKind::Perspective);
+  EXPECT_EQ(s.camera.up.z, 1.0f);
+  EXPECT_EQ(s.camera.fov_deg, 40.0);
+  EXPECT_EQ(s.camera.width, 512);
+  EXPECT_EQ(s.camera.height, 512);
+  EXPECT_EQ(s.camera.exposure, 1.0);
+  EXPECT_EQ(s.output, "out.exr");
+  EXPECT_FALSE(s.draw_stars);
+  EXPECT_EQ(s.star_psf_pixels, 1.5);
+  EXPECT_NO_THROW(validate_scene(s));
+}
+
+TEST_F(SceneFile, EveryFeatureLoads) {
+  density_file("data/cloud.h5");
+  H5Dataset b, v, r;
+  b.name = "glow_B";
+  v.name = "glow_V";
+  r.name = "glow_R";
+  for (H5Dataset* e : {&b, &v, &r}) {
+    e->dims = {2, 3, 4};
+    e->values.assign(24, 0.0);
+  }
+  b.values[5] = 2.5;
+  write_h5(path("data/glow.h5"), {b, v, r});
+  write_text("tables/tB.h5", "placeholder");  // only its existence is checked here
+  const std::string text = R"(
+bands = ["B", "V", "R"]
+[density]
+file = "data/cloud.h5"
+dataset = "tau_v"
+scale = 2.0
+[emission]
+file = "data/glow.h5"
+prefix = "glow_"
+[dust]
+albedo = { B = 0.7, V = 0.6, R = 0.5 }
+g = { R = 0.5, V = 0.55, B = 0.65 }
+R_V = 3.1
+law = "odonnell94"
+tables = { B = "tables/tB.h5", V = "" }
+[[stars]]
+position = [0.5, 0.5, 0.5]
+luminosity_lsun = 1e3
+temperature_K = 9000
+[[stars]]
+name = "second"
+position = [1.5, 1.0, 0.5]
+luminosity_lsun = 50
+class = "g2v"
+temperature_K = 5770
+[camera]
+kind = "orthographic"
+position = [1, 0.75, 10]
+look_at = [1, 0.75, 0.5]
+up = [0, 1, 0]
+ortho_width = 2.5
+width = 640
+height = 480
+exposure = 3.0
+[output]
+file = "nebula.fits"
+draw_stars = true
+star_psf_pixels = 2.0
+)";
+  const Scene s = load_scene(write_text("full.toml", text));
+  EXPECT_EQ(s.density.shape.nx, 4);
+  EXPECT_EQ(s.density.shape.nz, 2);
+  EXPECT_EQ(s.density.tau_v[0], 0.5f);  // 0.25 x scale 2
+  ASSERT_EQ(s.emission.size(), 3u);
+  EXPECT_EQ(s.emission[0][5], 2.5f);
+  EXPECT_EQ(s.dust.albedo, (std::vector<double>{0.7, 0.6, 0.5}));
+  EXPECT_EQ(s.dust.g, (std::vector<double>{0.65, 0.55, 0.5}));
+  EXPECT_EQ(s.dust.R_V, 3.1);
+  EXPECT_EQ(s.dust.law, ExtinctionLaw::ODonnell94);
+  EXPECT_EQ(s.dust.table_files[0], path("tables/tB.h5"));
+  EXPECT_EQ(s.dust.table_files[1], "");
+  EXPECT_EQ(s.dust.table_files[2], "");
+  ASSERT_EQ(s.stars.size(), 2u);
+  EXPECT_EQ(s.stars[0].name, "star 0");
+  EXPECT_EQ(s.stars[0].temperature_K, 9000.0);
+  EXPECT_EQ(s.stars[0].spectral_class, "");
+  EXPECT_EQ(s.stars[1].temperature_K, 5770.0);
+  EXPECT_FLOAT_EQ(s.stars[1].position.x, 1.5f);
+  EXPECT_EQ(s.camera.kind, CameraKind::Orthographic);
+  EXPECT_EQ(s.camera.ortho_width, 2.5);
+  EXPECT_EQ(s.camera.width, 640);
+  EXPECT_EQ(s.camera.height, 480);
+  EXPECT_EQ(s.camera.exposure, 3.0);
+  EXPECT_EQ(s.output, "nebula.fits");
+  EXPECT_TRUE(s.draw_stars);
+  EXPECT_EQ(s.star_psf_pixels, 2.0);
+
+  // One band only: per-band vectors follow the scene's bands.
+  const Scene v_only = load_scene_text(
+      std::string("bands = [\"V\"]\n") + kBase, "v.toml", dir_.string(), {"dust.albedo={V=0.4}"});
+  EXPECT_EQ(v_only.dust.albedo, std::vector<double>{0.4});
+  EXPECT_EQ(v_only.dust.g, std::vector<double>{0.6});
+}
+
+TEST_F(SceneFile, FitsDensityWithTheScenesVoxelSize) {
+  write_fits(path("cube.fits"), {4, 3, 2}, std::vector<double>(24, 0.5), FLOAT_IMG, {});
+  const Scene s = load_scene(write_text(
+      "fits.toml", edited("procedural = { n = 16, size_pc = 2.0, seed = 3 }",
+                          "fits = \"cube.fits\"\nvoxel_size_pc = 0.25")));
+  EXPECT_EQ(s.density.shape.nx, 4);
+  EXPECT_FLOAT_EQ(s.density.shape.voxel, 0.25f);
+}
+
+TEST_F(SceneFile, StarsMayTakeTheProceduralStarsPosition) {
+  const Scene s = load_scene(write_text("p.toml", edited("position = [1.0, 1.0, 1.0]\n", "")),
+                             {"density.procedural.star=[0.25, 0.5, 0.75]"});
+  EXPECT_FLOAT_EQ(s.stars[0].position.x, 0.5f);
+  EXPECT_FLOAT_EQ(s.stars[0].position.y, 1.0f);
+  EXPECT_FLOAT_EQ(s.stars[0].position.z, 1.5f);
+}
+
+// ------------------------------------------------------------ refusals
+
+const char* kProcedural = "procedural = { n = 16, size_pc = 2.0, seed = 3 }";
+
+TEST_F(SceneFile, RefusesUnknownKeysAtEveryLevel) {
+  refused("top", std::string("colour = 1\n") + kBase, {"colour", "unknown key"});
+  refused("camera_key", edited("[camera]\n", "[camera]\nfvo_deg = 30\n"), {"camera.fvo_deg", "unknown key", "fov_deg"});
+  refused("procedural_key", edited("seed = 3", "seed = 3, bubble_radiu = 0.1"),
+          {"density.procedural.bubble_radiu", "unknown key"});
+  refused("star_key", edited("class = \"O5V\"", "class = \"O5V\"\nlum = 3"), {"stars.0.lum", "unknown key"});
+  refused("density_key", edited("[density]\n", "[density]\nformat = \"h5\"\n"), {"density.format", "unknown key"});
+  refused("dust_key", edited("R_V = 5.0", "R_V = 5.0\nRv = 3"), {"dust.Rv", "unknown key"});
+  refused("output_key", edited("file = \"out.exr\"", "files = \"out.exr\""), {"output.files", "unknown key"});
+  refused("band_key", edited("albedo = 0.6", "albedo = { B = 0.6, V = 0.6, R = 0.6, U = 0.5 }"),
+          {"dust.albedo.U", "unknown band"});
+  refused("tables_key", edited("R_V = 5.0", "R_V = 5.0\ntables = { I = \"t.h5\" }"), {"dust.tables.I", "unknown band"});
+  refused("emission_key", std::string("[emission]\nfile = \"e.h5\"\nscale = 2\n") + kBase, {"emission.scale", "unknown key"});
+}
+
+TEST_F(SceneFile, RefusesWrongTypes) {
+  refused("fov_string", edited("[camera]\n", "[camera]\nfov_deg = \"wide\"\n"), {"camera.fov_deg", "number", "string"});
+  refused("width_float", edited("[camera]\n", "[camera]\nwidth = 512.5\n"), {"camera.width", "integer", "float"});
+  refused("position_short", edited("position = [1.0, -3.0, 1.0]", "position = [1.0, -3.0]"),
+          {"camera.position", "3 numbers"});
+  refused("position_text", edited("position = [1.0, -3.0, 1.0]", "position = [1.0, \"a\", 1.0]"),
+          {"camera.position[1]", "number"});
+  refused("stars_table", edited("[[stars]]", "[stars]"), {"stars", "array of tables"});
+  refused("draw_stars", edited("file = \"out.exr\"", "draw_stars = 1"), {"output.draw_stars", "true or false"});
+  refused("camera_value",
+          "camera = 3\n" + edited("[camera]\nposition = [1.0, -3.0, 1.0]\nlook_at = [1.0, 1.0, 1.0]", ""),
+          {"camera", "must be a table, got an integer"});
+  refused("seed_float", edited("seed = 3", "seed = 3.5"), {"density.procedural.seed", "integer"});
+  refused("nan", edited("R_V = 5.0", "R_V = nan"), {"dust.R_V", "finite"});
+  refused("syntax", edited("R_V = 5.0", "R_V = = 5"), {"TOML syntax"});
+}
+
+TEST_F(SceneFile, RefusesMissingRequiredKeys) {
+  std::string no_density = kBase;
+  no_density.replace(no_density.find("[density]"), std::string("[density]\n").size() + std::strlen(kProcedural) + 1, "");
+  refused("no_density", no_density, {"density", "missing"});
+  refused("no_source", edited(kProcedural, ""), {"density", "one of file"});
+  refused("no_camera", edited("[camera]\nposition = [1.0, -3.0, 1.0]\nlook_at = [1.0, 1.0, 1.0]", ""),
+          {"camera", "missing"});
+  refused("no_look_at", edited("look_at = [1.0, 1.0, 1.0]", ""), {"camera.look_at", "missing"});
+  refused("no_luminosity", edited("luminosity_lsun = 2e5", ""), {"stars.0.luminosity_lsun", "missing"});
+  refused("no_colour", edited("class = \"O5V\"", ""), {"stars.0", "temperature_K or class"});
+  std::string no_stars = kBase;
+  no_stars.replace(no_stars.find("[[stars]]"), no_stars.find("[camera]") - no_stars.find("[[stars]]"), "");
+  refused("no_stars", no_stars, {"stars", "at least one"});
+  density_file("cloud.h5");
+  std::string file_density = edited(kProcedural, "file = \"cloud.h5\"");
+  const std::string star_position = "position = [1.0, 1.0, 1.0]\n";
+  file_density.erase(file_density.find(star_position), star_position.size());
+  refused("no_star_position", file_density, {"stars.0.position", "missing"});
+  refused("ortho_no_width", edited("[camera]\n", "[camera]\nkind = \"orthographic\"\n"), {"camera.ortho_width", "missing"});
+  refused("emission_no_file", std::string("[emission]\nprefix = \"e_\"\n") + kBase, {"emission.file", "missing"});
+}
+
+TEST_F(SceneFile, RefusesBadDensityFiles) {
+  refused("missing_file", edited(kProcedural, "file = \"nowhere/cloud.h5\""),
+          {"density.file", "nowhere/cloud.h5", "cannot open"});
+  write_text("notes.h5", "just text");
+  refused("not_hdf5", edited(kProcedural, "file = \"notes.h5\""), {"density.file", "notes.h5", "not an HDF5"});
+  density_file("nan.h5", std::nan(""));
+  refused("nan_density", edited(kProcedural, "file = \"nan.h5\""), {"density.file", "nan.h5", "index 21", "nan"});
+  density_file("negative.h5", -2.0);
+  refused("negative_density", edited(kProcedural, "file = \"negative.h5\""), {"density.file", "index 21", "-2"});
+  density_file("inf.h5", INFINITY);
+  refused("inf_density", edited(kProcedural, "file = \"inf.h5\""), {"density.file", "index 21", "inf"});
+  density_file("cloud.h5");
+  refused("dataset", edited(kProcedural, "file = \"cloud.h5\"\ndataset = \"rho\""), {"density.file", "'rho'", "not found"});
+  refused("two_sources", edited(kProcedural, std::string(kProcedural) + "\nfile = \"cloud.h5\""),
+          {"density.procedural", "conflicts with density.file"});
+  refused("voxel_with_h5", edited(kProcedural, "file = \"cloud.h5\"\nvoxel_size_pc = 0.1"),
+          {"density.voxel_size_pc", "fits only"});
+  write_fits(path("cube.fits"), {4, 3, 2}, std::vector<double>(24, 0.5), FLOAT_IMG, {});
+  refused("fits_no_voxel", edited(kProcedural, "fits = \"cube.fits\""), {"density.fits", "cube.fits", "CDELT"});
+  refused("scale", edited(kProcedural, std::string(kProcedural) + "\nscale = 0"), {"density.scale", "> 0"});
+  refused("scale_overflow", edited(kProcedural, "file = \"cloud.h5\"\nscale = 1e300"), {"density.scale", "inf"});
+
+  H5Dataset huge;
+  huge.dims = {100000, 100000, 100000};
+  huge.voxel_size = 0.1;
+  write_h5(path("huge.h5"), {huge});
+  refused("huge", edited(kProcedural, "file = \"huge.h5\""), {"density.file", "huge.h5", "3.55 PiB", "limit"});
+  refused("huge_procedural", edited("n = 16", "n = 100000"), {"density.procedural.n", "limit"});
+  refused("procedural_param", edited("seed = 3", "seed = 3, bubble_offset = 0.5"),
+          {"density.procedural.bubble_offset", "bubble_radius"});
+
+  H5Dataset e;
+  e.name = "emission_B";
+  e.dims = {2, 3, 5};
+  e.values.assign(30, 0.0);
+  write_h5(path("em.h5"), {e});
+  refused("emission_shape", std::string("[emission]\nfile = \"em.h5\"\n") + edited(kProcedural, "file = \"cloud.h5\""),
+          {"emission.file", "em.h5", "emission_B", "differs"});
+  refused("table_missing", edited("R_V = 5.0", "R_V = 5.0\ntables = { V = \"tV.h5\" }"), {"dust.tables.V", "tV.h5"});
+}
+
+TEST_F(SceneFile, RefusesAMissingSceneFile) {
+  expect_error([&] { load_scene(path("nothing.toml")); }, {"nothing.toml", "cannot read", "No such file"});
+  expect_error([&] { load_scene(dir_.string()); }, {"directory"});
+}
+
+TEST_F(SceneFile, RefusesBadStars) {
+  refused("zero_luminosity", edited("2e5", "0"), {"stars.0.luminosity_lsun", "> 0"});
+  refused("negative_luminosity", edited("2e5", "-1"), {"stars.0.luminosity_lsun", "> 0"});
+  refused("unknown_class", edited("\"O5V\"", "\"X9V\""), {"stars.0.class", "X9V", "O5V"});
+  refused("disagreeing", edited("class = \"O5V\"", "class = \"O5V\"\ntemperature_K = 30000"),
+          {"stars.0.temperature_K", "30000", "41400", "O5V"});
+  refused("cold", edited("class = \"O5V\"", "temperature_K = -5"), {"stars.0.temperature_K", "> 0"});
+  // The second star is named by its index.
+  refused("second", std::string(kBase) + "[[stars]]\nposition = [0, 0, 0]\nluminosity_lsun = 1\n",
+          {"stars.1", "temperature_K or class"});
+}
+
+TEST_F(SceneFile, RefusesBadDust) {
+  refused("albedo_high", edited("albedo = 0.6", "albedo = 1.2"), {"dust.albedo", "[0, 1]"});
+  refused("albedo_band", edited("albedo = 0.6", "albedo = { B = -0.1, V = 0.6, R = 0.6 }"), {"dust.albedo.B", "[0, 1]"});
+  refused("albedo_missing_band", edited("albedo = 0.6", "albedo = { B = 0.5, V = 0.6 }"), {"dust.albedo.R", "every band"});
+  refused("g_one", edited("g = 0.6", "g = 1.0"), {"dust.g", "(-1, 1)"});
+  refused("g_minus_one", edited("g = 0.6", "g = -1"), {"dust.g", "(-1, 1)"});
+  refused("rv_low", edited("R_V = 5.0", "R_V = 1.5"), {"dust.R_V", "[2, 6]"});
+  refused("rv_high", edited("R_V = 5.0", "R_V = 6.5"), {"dust.R_V", "[2, 6]"});
+  refused("law", edited("R_V = 5.0", "law = \"fitzpatrick99\""), {"dust.law", "fitzpatrick99"});
+  refused("bands", std::string("bands = [\"B\", \"U\"]\n") + kBase, {"bands", "'U'"});
+  refused("bands_twice", std::string("bands = [\"B\", \"B\"]\n") + kBase, {"bands", "twice"});
+}
+
+TEST_F(SceneFile, RefusesBadCameras) {
+  refused("zero_view", edited("look_at = [1.0, 1.0, 1.0]", "look_at = [1.0, -3.0, 1.0]"), {"camera.look_at", "zero length"});
+  refused("up_parallel", edited("[camera]\n", "[camera]\nup = [0, 2, 0]\n"), {"camera.up", "parallel"});
+  refused("up_zero", edited("[camera]\n", "[camera]\nup = [0, 0, 0]\n"), {"camera.up", "zero"});
+  refused("fov_zero", edited("[camera]\n", "[camera]\nfov_deg = 0\n"), {"camera.fov_deg", "(0, 180)"});
+  refused("fov_180", edited("[camera]\n", "[camera]\nfov_deg = 180\n"), {"camera.fov_deg", "(0, 180)"});
+  refused("width_zero", edited("[camera]\n", "[camera]\nwidth = 0\n"), {"camera.width", ">= 1"});
+  refused("height_negative", edited("[camera]\n", "[camera]\nheight = -4\n"), {"camera.height", ">= 1"});
+  refused("fisheye_wide", edited("[camera]\n", "[camera]\nkind = \"fisheye\"\nwidth = 1024\n"), {"camera.height", "square"});
+  refused("kind", edited("[camera]\n", "[camera]\nkind = \"pinhole\"\n"), {"camera.kind", "pinhole"});
+  refused("exposure", edited("[camera]\n", "[camera]\nexposure = 0\n"), {"camera.exposure", "> 0"});
+  refused("ortho_negative", edited("[camera]\n", "[camera]\nkind = \"orthographic\"\northo_width = -2\n"),
+          {"camera.ortho_width", "> 0"});
+  refused("psf", edited("file = \"out.exr\"", "star_psf_pixels = 0"), {"output.star_psf_pixels"});
+}
+
+// ------------------------------------------------------------ overrides
+
+TEST_F(SceneFile, OverridesApplyBeforeValidation) {
+  const std::string file = write_text("o.toml", kBase);
+  const Scene s = load_scene(file, {"camera.fov_deg=30", "dust.albedo=0.8", "stars.0.luminosity_lsun=1e4",
+                                    "camera.kind=fisheye", "output.draw_stars=true",
+                                    "dust.g={B=0.7, V=0.6, R=0.5}", "camera.position=[1, -4, 1]",
+                                    "stars.0.name=\"renamed\"", "camera.look_at.2=1.5"});
+  EXPECT_EQ(s.camera.fov_deg, 30.0);
+  EXPECT_EQ(s.dust.albedo, std::vector<double>(3, 0.8));
+  EXPECT_EQ(s.stars[0].luminosity_lsun, 1e4);
+  EXPECT_EQ(s.stars[0].name, "renamed");
+  EXPECT_EQ(s.camera.kind, CameraKind::Fisheye);
+  EXPECT_TRUE(s.draw_stars);
+  EXPECT_EQ(s.dust.g, (std::vector<double>{0.7, 0.6, 0.5}));
+  EXPECT_FLOAT_EQ(s.camera.position.y, -4.0f);
+  EXPECT_FLOAT_EQ(s.camera.look_at.z, 1.5f);  // one element of an array
+
+  // An override can repair a file (validation comes after), create a table,
+  // append a star and change the procedural seed.
+  const Scene t = load_scene(write_text("fix.toml", edited("R_V = 5.0", "R_V = 9")),
+                             {"dust.R_V=3.1", "stars.1.luminosity_lsun=10", "stars.1.class=B0V",
+                              "stars.1.position=[0, 0, 0]", "density.procedural.seed=4"});
+  EXPECT_EQ(t.dust.R_V, 3.1);
+  ASSERT_EQ(t.stars.size(), 2u);
+  EXPECT_EQ(t.stars[1].temperature_K, 31400.0);
+  EXPECT_NE(t.density.tau_v, s.density.tau_v);
+
+  std::string no_output = kBase;
+  no_output.erase(no_output.find("[output]"));
+  const Scene u = load_scene(write_text("noout.toml", no_output), {"output.file=x.fits"});
+  EXPECT_EQ(u.output, "x.fits");
+}
+
+TEST_F(SceneFile, OverridesAreCheckedLikeTheFile) {
+  write_text("o.toml", kBase);
+  refused("o", kBase, {"camera.fvo_deg", "unknown key", "set by override 'camera.fvo_deg=30'"}, {"camera.fvo_deg=30"});
+  refused("o", kBase, {"colour", "unknown key", "override"}, {"colour.red=1"});
+  refused("o", kBase, {"camera.fov_deg", "(0, 180)", "set by override 'camera.fov_deg=200'"}, {"camera.fov_deg=200"});
+  refused("o", kBase, {"camera.width", "integer", "string", "override"}, {"camera.width=wide"});
+  refused("o", kBase, {"dust.albedo", "[0, 1]", "override"}, {"dust.albedo=2"});
+  refused("o", kBase, {"stars.5", "out of range", "1 elements"}, {"stars.5.luminosity_lsun=3"});
+  refused("o", kBase, {"stars.x", "0-based index"}, {"stars.x.luminosity_lsun=3"});
+  refused("o", kBase, {"dust.R_V", "is a float, not a table"}, {"dust.R_V.x=1"});
+  refused("o", kBase, {"camera.position.x", "0-based index"}, {"camera.position.x=1"});
+  refused("o", kBase, {"override 'fov'", "KEY=VALUE"}, {"fov"});
+  refused("o", kBase, {"override", "bad key"}, {"camera..fov_deg=3"});
+}
+
+// ------------------------------------------------------------ built-in and examples
+
+const std::string kScenes = NEBULA_SCENES_DIR;
+
+void expect_same_scene(const Scene& a, const Scene& b) {
+  EXPECT_EQ(a.bands, b.bands);
+  EXPECT_EQ(a.density.shape.nx, b.density.shape.nx);
+  EXPECT_EQ(a.density.shape.ny, b.density.shape.ny);
+  EXPECT_EQ(a.density.shape.nz, b.density.shape.nz);
+  EXPECT_EQ(a.density.shape.voxel, b.density.shape.voxel);
+  EXPECT_EQ(a.density.shape.origin.x, b.density.shape.origin.x);
+  EXPECT_EQ(a.density.shape.origin.y, b.density.shape.origin.y);
+  EXPECT_EQ(a.density.shape.origin.z, b.density.shape.origin.z);
+  EXPECT_TRUE(a.density.tau_v == b.density.tau_v);
+  EXPECT_EQ(a.emission.size(), b.emission.size());
+  EXPECT_EQ(a.dust.albedo, b.dust.albedo);
+  EXPECT_EQ(a.dust.g, b.dust.g);
+  EXPECT_EQ(a.dust.R_V, b.dust.R_V);
+  EXPECT_EQ(a.dust.law, b.dust.law);
+  EXPECT_EQ(a.dust.table_files, b.dust.table_files);
+  ASSERT_EQ(a.stars.size(), b.stars.size());
+  for (size_t i = 0; i < a.stars.size(); ++i) {
+    EXPECT_EQ(a.stars[i].name, b.stars[i].name);
+    EXPECT_EQ(a.stars[i].position.x, b.stars[i].position.x);
+    EXPECT_EQ(a.stars[i].position.y, b.stars[i].position.y);
+    EXPECT_EQ(a.stars[i].position.z, b.stars[i].position.z);
+    EXPECT_EQ(a.stars[i].luminosity_lsun, b.stars[i].luminosity_lsun);
+    EXPECT_EQ(a.stars[i].temperature_K, b.stars[i].temperature_K);
+    EXPECT_EQ(a.stars[i].spectral_class, b.stars[i].spectral_class);
+  }
+  const CameraSpec &c = a.camera, &d = b.camera;
+  EXPECT_EQ(c.kind, d.kind);
+  for (auto [p, q] : {std::pair{c.position, d.position}, {c.look_at, d.look_at}, {c.up, d.up}}) {
+    EXPECT_EQ(p.x, q.x);
+    EXPECT_EQ(p.y, q.y);
+    EXPECT_EQ(p.z, q.z);
+  }
+  EXPECT_EQ(c.fov_deg, d.fov_deg);
+  EXPECT_EQ(c.ortho_width, d.ortho_width);
+  EXPECT_EQ(c.width, d.width);
+  EXPECT_EQ(c.height, d.height);
+  EXPECT_EQ(c.exposure, d.exposure);
+  EXPECT_EQ(a.output, b.output);
+  EXPECT_EQ(a.draw_stars, b.draw_stars);
+  EXPECT_EQ(a.star_psf_pixels, b.star_psf_pixels);
+}
+
+TEST(Examples, DemoSceneValidatesAndEqualsDemoToml) {
+  const Scene demo = demo_scene();
+  EXPECT_NO_THROW(validate_scene(demo));
+  EXPECT_EQ(demo.density.shape.nx, 128);
+  ASSERT_EQ(demo.stars.size(), 1u);
+  EXPECT_EQ(demo.stars[0].spectral_class, "O5V");
+  // The camera is outside the cloud, looking at the star.
+  const Vec3 upper = demo.density.shape.upper();
+  EXPECT_TRUE(demo.camera.position.y < demo.density.shape.origin.y || demo.camera.position.y > upper.y);
+  const Scene file = load_scene(kScenes + "/demo.toml");
+  expect_same_scene(file, demo);
+}
+
+TEST(Examples, Fig12ReferenceLoads) {
+  const Scene s = load_scene(kScenes + "/fig12_reference.toml");
+  EXPECT_EQ(s.dust.albedo, std::vector<double>(3, 0.6));
+  EXPECT_EQ(s.dust.g, std::vector<double>(3, 0.6));
+  EXPECT_EQ(s.dust.R_V, 5.0);
+  ASSERT_EQ(s.stars.size(), 1u);
+  EXPECT_EQ(s.stars[0].spectral_class, "O5V");
+  // The paper's variations are one override away.
+  const Scene g2 = load_scene(kScenes + "/fig12_reference.toml",
+                              {"stars.0.class=G2V", "dust.R_V=3.1"});
+  EXPECT_EQ(g2.stars[0].temperature_K, 5770.0);
+  EXPECT_EQ(g2.dust.R_V, 3.1);
+}
+
+TEST(Examples, UniformSphereIsUniformInsideAndEmptyOutside) {
+  const Scene s = load_scene(kScenes + "/uniform_sphere.toml");
+  const GridShape& g = s.density.shape;
+  const Vec3 star = s.stars.at(0).position;
+  const double radius = 0.4 * g.nx * g.voxel;  // bubble_radius 0.4 of the edge
+  float inside = -1;
+  size_t in = 0, out = 0;
+  for (int z = 0; z < g.nz; ++z)
+    for (int y = 0; y < g.ny; ++y)
+      for (int x = 0; x < g.nx; ++x) {
+        const Vec3 c = g.centre(x, y, z);
+        const double r = length(c - star);
+        const float v = s.density.tau_v[g.index(x, y, z)];
+        if (r < radius - 0.5 * g.voxel) {
+          if (inside < 0) inside = v;
+          ASSERT_EQ(v, inside);
+          ++in;
+        } else if (r > radius + 0.5 * g.voxel) {
+          ASSERT_EQ(v, 0.0f);
+          ++out;
+        }
+      }
+  EXPECT_GT(inside, 0.0f);
+  EXPECT_GT(in, 1000u);
+  EXPECT_GT(out, 1000u);
+}
+
+TEST(Examples, EveryExampleSceneLoads) {
+  size_t count = 0;
+  for (const auto& entry : testing::fs::directory_iterator(kScenes)) {
+    if (entry.path().extension() != ".toml") continue;
+    SCOPED_TRACE(entry.path().string());
+    EXPECT_NO_THROW(load_scene(entry.path().string()));
+    ++count;
+  }
+  EXPECT_GE(count, 3u);
+}
+
+TEST(Scene, ValidateSceneNamesTheKey) {
+  Scene s = demo_scene();
+  s.camera.fov_deg = 0;
+  expect_error([&] { validate_scene(s); }, {"demo", "camera.fov_deg"});
+  s = demo_scene();
+  s.dust.albedo = {0.6, 1.5, 0.6};
+  expect_error([&] { validate_scene(s); }, {"demo", "dust.albedo.V"});
+  s = demo_scene();
+  s.density.tau_v[7] = -1;
+  expect_error([&] { validate_scene(s); }, {"demo", "density", "index 7"});
+  s = demo_scene();
+  s.stars[0].temperature_K = 5000;
+  expect_error([&] { validate_scene(s); }, {"demo", "stars.0.temperature_K", "O5V"});
+  s = demo_scene();
+  s.dust.g.pop_back();
+  expect_error([&] { validate_scene(s); }, {"demo", "dust.g", "2 values for 3 bands"});
+  EXPECT_STREQ(to_string(CameraKind::Fisheye), "fisheye");
+}
+
+}  // namespace
+}  // namespace nebula

@@ -1,0 +1,85 @@
+#!/usr/bin/env python3
+"""The 2005 paper's Fig. 12 parameter study, from one scene.
+
+Renders scenes/fig12_reference.toml (a = 0.6, g = 0.6, R_V = 5, an O5V star)
+and four variants, each changing one thing: R_V = 3.1, a Sun-like (G2V) star
+of the same luminosity, albedo 0.8, g = 0.8. Every image has the same
+exposure, so brightness and colour compare directly. Writes one PNG per
+variant (into --renders) and a montage (into --out).
+
+Usage: /usr/bin/python3 validation/gallery.py [--nebula build/bin/nebula]
+           [--scene scenes/fig12_reference.toml] [--out docs/images]
+           [--size 384] [--backend auto]
+Needs numpy and matplotlib (Debian: python3-numpy, python3-matplotlib).
+"""
+import argparse
+import os
+import subprocess
+import sys
+
+VARIANTS = [
+    ("reference", "reference\na = 0.6, g = 0.6, R_V = 5, O5V", []),
+    ("rv31", "R_V = 3.1", ["dust.R_V=3.1"]),
+    ("sunlike", "Sun-like star (G2V)", ['stars.0.class="G2V"']),
+    ("albedo08", "albedo a = 0.8", ["dust.albedo=0.8"]),
+    ("g08", "anisotropy g = 0.8", ["dust.g=0.8"]),
+]
+
+
+def fail(message):
+    print(f"gallery.py: error: {message}", file=sys.stderr)
+    sys.exit(1)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--nebula", default="build/bin/nebula")
+    parser.add_argument("--scene", default="scenes/fig12_reference.toml")
+    parser.add_argument("--out", default="docs/images", help="folder for the montage")
+    parser.add_argument("--renders", default="out/gallery", help="folder for the single images")
+    parser.add_argument("--size", type=int, default=384, help="image width and height in pixels")
+    parser.add_argument("--backend", default="auto")
+    args = parser.parse_args()
+    if not os.access(args.nebula, os.X_OK):
+        fail(f"{args.nebula}: not an executable (build first: scripts/test.sh)")
+    if not os.path.isfile(args.scene):
+        fail(f"{args.scene}: no such scene file")
+    if not os.path.isdir(args.out):
+        fail(f"{args.out}: no such folder")
+    os.makedirs(args.renders, exist_ok=True)
+    if args.size < 16:
+        fail("--size: at least 16 pixels")
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    panels = []
+    for key, title, overrides in VARIANTS:
+        path = os.path.join(args.renders, f"fig12_{key}.png")
+        command = [args.nebula, "render", args.scene, "-o", path, "--force", "-q",
+                   "--backend", args.backend, "--width", str(args.size), "--height", str(args.size)]
+        for o in overrides:
+            command += ["--set", o]
+        print("$", " ".join(command), flush=True)
+        result = subprocess.run(command, capture_output=True, text=True)
+        if result.returncode != 0:
+            fail(f"rendering {key} failed: {result.stderr.strip()}")
+        panels.append((title, path))
+
+    fig, axes = plt.subplots(1, len(panels), figsize=(3.2 * len(panels), 3.7), dpi=100)
+    for ax, (title, path) in zip(axes, panels):
+        ax.imshow(plt.imread(path))
+        ax.set_title(title, fontsize=10)
+        ax.axis("off")
+    fig.suptitle("Parameter study after Magnor et al. 2005, Fig. 12 (same exposure throughout)")
+    fig.tight_layout()
+    montage = os.path.join(args.out, "fig12_study.png")
+    fig.savefig(montage + ".tmp.png")
+    os.replace(montage + ".tmp.png", montage)
+    print(f"wrote {montage}")
+
+
+if __name__ == "__main__":
+    main()
