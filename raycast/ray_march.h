@@ -115,7 +115,8 @@ struct MarchMode {
 // enters that voxel (DESIGN.md: P holds the voxel's own extinction, so a
 // sub-voxel step must not darken its voxel again); the smooth mode spreads
 // the voxel's chord over samples of the interpolated fields inside it.
-NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchMode mode = {}) {
+template <bool kSmooth>
+NEBULA_HD RayResult march_ray_in_mode(const MarchScene& s, Vec3 origin, Vec3 dir, MarchMode mode) {
   RayResult out{};
   for (int b = 0; b < kMaxBands; ++b) out.transmittance[b] = 1.0f;
   const GridShape& g = s.density.shape;
@@ -132,7 +133,7 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchM
   traverse_segment(g, origin, origin + far * dir, [&](size_t cell, float chord) -> bool {
     const float tau_v = s.density.tau_v[cell];
     float source[kMaxBands] = {};
-    if (step > 0.0f) {
+    if constexpr (kSmooth) {
       // Samples at t_enter + (k + 1/2) step that fall inside this voxel.
       const float first = ceilf((t - t_enter) / step - 0.5f);
       for (float k = fmaxf(first, 0.0f);; k += 1.0f) {
@@ -168,6 +169,13 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchM
     return visible;
   });
   return out;
+}
+
+// The exact traversal and the smooth mode are compiled apart, so the
+// reference path carries none of the sampling code (registers, branches).
+NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchMode mode = {}) {
+  return mode.step_voxels > 0.0f ? march_ray_in_mode<true>(s, origin, dir, mode)
+                                 : march_ray_in_mode<false>(s, origin, dir, mode);
 }
 
 }  // namespace nebula

@@ -35,6 +35,7 @@ class DeviceArray {
   size_t size_ = 0;
 };
 
+template <bool kSmooth>
 __global__ void render_kernel(MarchScene scene, Camera camera, MarchMode mode, float exposure,
                               float* pixels, unsigned long long* clamps) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x;
@@ -42,7 +43,7 @@ __global__ void render_kernel(MarchScene scene, Camera camera, MarchMode mode, f
   if (x >= camera.width || y >= camera.height) return;
   Vec3 origin, dir;
   if (!camera.ray(x, y, origin, dir)) return;
-  const RayResult r = march_ray(scene, origin, dir, mode);
+  const RayResult r = march_ray_in_mode<kSmooth>(scene, origin, dir, mode);
   const size_t plane = size_t(camera.width) * camera.height;
   for (int b = 0; b < scene.n_bands; ++b) pixels[b * plane + size_t(y) * camera.width + x] = exposure * r.radiance[b];
   if (r.table_clamps) atomicAdd(clamps, static_cast<unsigned long long>(r.table_clamps));
@@ -95,7 +96,11 @@ Image render_cuda(const RenderInputs& in, RenderStats* stats) {
   NEBULA_CUDA_CHECK(cudaEventCreate(&start));
   NEBULA_CUDA_CHECK(cudaEventCreate(&stop));
   NEBULA_CUDA_CHECK(cudaEventRecord(start));
-  render_kernel<<<grid, block>>>(scene, in.camera, in.mode, in.exposure, pixels.get(), clamps.get());
+  // One kernel per mode: the exact one carries none of the smooth mode's code.
+  if (in.mode.step_voxels > 0.0f)
+    render_kernel<true><<<grid, block>>>(scene, in.camera, in.mode, in.exposure, pixels.get(), clamps.get());
+  else
+    render_kernel<false><<<grid, block>>>(scene, in.camera, in.mode, in.exposure, pixels.get(), clamps.get());
   NEBULA_CUDA_CHECK(cudaGetLastError());
   NEBULA_CUDA_CHECK(cudaEventRecord(stop));
   NEBULA_CUDA_CHECK(cudaEventSynchronize(stop));

@@ -38,10 +38,25 @@ TEST(RendererGpu, AgreesWithTheCpu) {
       peak = std::max(peak, double(cpu.pixels[i]));
       worst = std::max(worst, double(std::fabs(cpu.pixels[i] - gpu.pixels[i])));
     }
-    std::printf("%s: largest CPU-GPU difference %.3g of the peak %.3g\n",
-                mode.step_voxels > 0 ? "smooth" : "exact", worst / peak, peak);
+    double mean = 0;
+    for (size_t i = 0; i < cpu.pixels.size(); ++i) mean += std::fabs(cpu.pixels[i] - gpu.pixels[i]);
+    mean /= cpu.pixels.size();
+    std::printf("%s: largest CPU-GPU difference %.3g of the peak %.3g, mean %.3g of it\n",
+                mode.step_voxels > 0 ? "smooth" : "exact", worst / peak, peak, mean / peak);
     EXPECT_GT(peak, 0.0);
-    EXPECT_LT(worst, 1e-4 * peak);
+    if (mode.step_voxels == 0) {
+      EXPECT_LT(worst, 1e-4 * peak);
+    } else {
+      // A smooth-mode sample within rounding of a voxel boundary may fall on
+      // either side, seen through either voxel's entry transmittance: its
+      // contribution (at most its pixel's value) changes by at most
+      // 1 - exp(-tau_max A_max/A_V), here 1 - exp(-0.4). Such flips are rare,
+      // so on average the backends must still agree to 1e-5 of the peak.
+      const double flip = 1 - std::exp(-0.4);
+      for (size_t i = 0; i < cpu.pixels.size(); ++i)
+        EXPECT_LE(std::fabs(cpu.pixels[i] - gpu.pixels[i]), 1e-4 * peak + flip * cpu.pixels[i]);
+      EXPECT_LT(mean, 1e-5 * peak);
+    }
     EXPECT_EQ(cpu_stats.table_clamps, gpu_stats.table_clamps);
   }
 }

@@ -19,3 +19,4 @@ nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm,memory.total 
 "$B/bin/nebula" bench tabulate --backend both --repeats 5 2>&1 | tee "$OUT/bench.log"
 "$B/bin/nebula" bench bake --backend both --size 256 --stars 4 2>&1 | tee "$OUT/bench_bake.log"
 "$B/bin/nebula" bench render --backend both --size 256 --stars 8 2>&1 | tee "$OUT/bench_render.log"
+"$B/bin/nebula" render --demo --backend cuda --force -o "$OUT/demo.h5" 2>&1 | tee "$OUT/render_demo.log"
