@@ -20,6 +20,7 @@
 #include "illumination/passband.h"
 #include "illumination/star.h"
 #include "imageio/image_output.h"
+#include "raycast/point_stars.h"
 #include "raycast/renderer.h"
 #include "scene/scene_file.h"
 #include "tables/table_file.h"
@@ -50,43 +51,6 @@ Camera camera_of(const CameraSpec& c) {
   s.width = c.width;
   s.height = c.height;
   return make_camera(s);
-}
-
-// Adds each star as an attenuated point source: its flux Phi / (4 pi d^2)
-// exp(-tau_b) spread by a Gaussian PSF over the pixels, as radiance (flux over
-// the pixel's solid angle). Perspective cameras only, for now.
-void draw_stars(const Scene& scene, const std::vector<std::vector<float>>& power,
-                const std::vector<float>& ratios, const Camera& cam, Image& image) {
-  if (cam.projection != Projection::Perspective)
-    throw Error(scene.path + ": output.draw_stars: drawn stars need a perspective camera for now");
-  const double pixel_angle = 2.0 * cam.tan_half_fov / cam.height;  // radians per pixel at the centre
-  const double sigma = scene.star_psf_pixels;
-  for (size_t k = 0; k < scene.stars.size(); ++k) {
-    const Vec3 d = scene.stars[k].position - cam.position;
-    const float along = dot(d, cam.forward);
-    if (!(along > 0)) continue;  // behind the camera
-    const float aspect = float(cam.width) / cam.height;
-    const double px = ((dot(d, cam.right) / along) / (aspect * cam.tan_half_fov) + 1) * 0.5 * cam.width - 0.5;
-    const double py = (1 - (dot(d, cam.up) / along) / cam.tan_half_fov) * 0.5 * cam.height - 0.5;
-    const double dist2 = dot(d, d);
-    const float tau_v = segment_optical_depth(scene.density.view(), cam.position, scene.stars[k].position);
-    const int radius = static_cast<int>(std::ceil(4 * sigma));
-    double norm = 0;
-    for (int y = -radius; y <= radius; ++y)
-      for (int x = -radius; x <= radius; ++x) norm += std::exp(-(x * x + y * y) / (2 * sigma * sigma));
-    for (int y = -radius; y <= radius; ++y)
-      for (int x = -radius; x <= radius; ++x) {
-        const int ix = static_cast<int>(std::lround(px)) + x, iy = static_cast<int>(std::lround(py)) + y;
-        if (ix < 0 || iy < 0 || ix >= cam.width || iy >= cam.height) continue;
-        const double dx = ix - px, dy = iy - py;
-        const double w = std::exp(-(dx * dx + dy * dy) / (2 * sigma * sigma)) / norm;
-        for (size_t b = 0; b < ratios.size(); ++b) {
-          const double flux = power[k][b] / (4 * kPiD * dist2) * std::exp(-tau_v * ratios[b]);
-          image.at(int(b), ix, iy) += static_cast<float>(scene.camera.exposure * flux * w /
-                                                         (pixel_angle * pixel_angle));
-        }
-      }
-  }
 }
 
 // Refuses an image format before any work: by extension, and .exr/.png when
@@ -181,7 +145,12 @@ void run_render(const Options& o) {
   BakeResult bake;
   if (scatters && !positions.empty()) {
     const auto t0 = std::chrono::steady_clock::now();
-    bake = bake_star_depths(scene.density, positions, backend);
+    std::unique_ptr<Progress> progress;
+    if (!o.quiet && backend == Backend::Cpu)
+      progress = std::make_unique<Progress>("bake", uint64_t(positions.size()) * scene.density.shape.ny *
+                                                        scene.density.shape.nz);
+    bake = bake_star_depths(scene.density, positions, backend, progress.get());
+    if (progress) progress->finish();
     computed.push_back("bake: " + std::to_string(positions.size()) + " star(s) x " +
                        std::to_string(scene.density.shape.count()) + " voxels, " + num(seconds_since(t0)) + " s");
   } else {
@@ -199,9 +168,18 @@ void run_render(const Options& o) {
   in.exposure = static_cast<float>(scene.camera.exposure);
   in.mode = MarchMode{o.smooth, true};
   RenderStats stats;
-  const auto t_render = std::chrono::steady_clock::now();
+  std::unique_ptr<Progress> render_progress;
+  if (!o.quiet && backend == Backend::Cpu)
+    render_progress = std::make_unique<Progress>("render", uint64_t(camera.height));
+  in.progress = render_progress.get();
   Image image = render(in, backend, &stats);
-  if (scene.draw_stars) draw_stars(scene, power, ratios, camera, image);
+  if (render_progress) render_progress->finish();
+  if (scene.draw_stars) {
+    std::vector<PointStar> points;
+    for (size_t k = 0; k < positions.size(); ++k) points.push_back(PointStar{positions[k], power[k]});
+    draw_point_stars(scene.density, points, ratios, camera, static_cast<float>(scene.camera.exposure),
+                     scene.star_psf_pixels, image);
+  }
 
   ImageMetadata meta;
   meta.units = "L_sun pc^-2 sr^-1 x exposure";
@@ -232,7 +210,6 @@ void run_render(const Options& o) {
   std::printf("  pyramid levels: none (not yet implemented)\n");
   std::printf("render: %.3f s marching, %llu table lookups beyond tau_max (clamped); total %.2f s\n", stats.seconds,
               (unsigned long long)stats.table_clamps, seconds_since(start));
-  (void)t_render;
   std::printf("wrote %s\n", out.c_str());
 }
 

@@ -5,9 +5,11 @@
 
 #include <chrono>
 
+#include "core/progress.h"
+
 namespace nebula {
 
-BakeResult bake_star_depths_cpu(const DensityGrid& grid, const std::vector<Vec3>& stars) {
+BakeResult bake_star_depths_cpu(const DensityGrid& grid, const std::vector<Vec3>& stars, Progress* progress) {
   BakeResult out;
   const auto start = std::chrono::steady_clock::now();
   const DensityView view = grid.view();
@@ -20,6 +22,7 @@ BakeResult bake_star_depths_cpu(const DensityGrid& grid, const std::vector<Vec3>
         const int y = row % g.ny, z = row / g.ny;
         for (int x = 0; x < g.nx; ++x) depth[g.index(x, y, z)] = star_to_voxel_depth(view, star, x, y, z);
       }
+      if (progress) progress->add(rows.size());
     });
     out.tau_v.push_back(std::move(depth));
   }
@@ -27,8 +30,9 @@ BakeResult bake_star_depths_cpu(const DensityGrid& grid, const std::vector<Vec3>
   return out;
 }
 
-BakeResult bake_star_depths(const DensityGrid& grid, const std::vector<Vec3>& stars, Backend backend) {
-  return backend == Backend::Cuda ? bake_star_depths_cuda(grid, stars) : bake_star_depths_cpu(grid, stars);
+BakeResult bake_star_depths(const DensityGrid& grid, const std::vector<Vec3>& stars, Backend backend,
+                            Progress* progress) {
+  return backend == Backend::Cuda ? bake_star_depths_cuda(grid, stars) : bake_star_depths_cpu(grid, stars, progress);
 }
 
 }  // namespace nebula

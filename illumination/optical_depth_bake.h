@@ -43,9 +43,14 @@ struct BakeResult {
   double seconds = 0;                     // compute time (CUDA events on the GPU)
 };
 
-// Bakes every star; the grid goes to the GPU once for all stars.
-BakeResult bake_star_depths(const DensityGrid& grid, const std::vector<Vec3>& stars, Backend backend);
-BakeResult bake_star_depths_cpu(const DensityGrid& grid, const std::vector<Vec3>& stars);
+class Progress;
+
+// Bakes every star; the grid goes to the GPU once for all stars. Progress
+// (CPU only, may be null) advances in voxel rows.
+BakeResult bake_star_depths(const DensityGrid& grid, const std::vector<Vec3>& stars, Backend backend,
+                            Progress* progress = nullptr);
+BakeResult bake_star_depths_cpu(const DensityGrid& grid, const std::vector<Vec3>& stars,
+                                Progress* progress = nullptr);
 BakeResult bake_star_depths_cuda(const DensityGrid& grid, const std::vector<Vec3>& stars);
 
 }  // namespace nebula

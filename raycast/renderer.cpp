@@ -7,6 +7,7 @@
 #include <chrono>
 
 #include "core/error.h"
+#include "core/progress.h"
 
 namespace nebula {
 
@@ -67,6 +68,7 @@ Image render_cpu(const RenderInputs& in, RenderStats* stats) {
         local_clamps += r.table_clamps;
       }
     clamps += local_clamps;
+    if (in.progress) in.progress->add(rows.size());
   });
   if (stats) {
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

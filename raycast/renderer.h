@@ -13,6 +13,8 @@
 
 namespace nebula {
 
+class Progress;
+
 struct RenderBand {
   std::string name;             // "B", "V", "R"
   float extinction_ratio = 1;   // A_b / A_V
@@ -35,6 +37,7 @@ struct RenderInputs {
   float exposure = 1.0f;
   float min_transmittance = 1e-4f;
   MarchMode mode;  // exact traversal by default; step_voxels > 0: smooth display mode
+  Progress* progress = nullptr;  // advanced in image rows (CPU); may be null
 };
 
 struct RenderStats {

@@ -30,8 +30,9 @@ Camera telescope(int pixels, float width) {
 // Optically thin uniform sphere around a central star, seen from far away
 // along +z: the rendered profile against the line-of-sight integral of the
 // single-scattering source, I(b) = int sigma_sct Phi / (4 pi r^2) p(mu) dz with
-// mu = -z / r (REFERENCES.md). The reference integrates the table's own p
-// (its lookup), so the test measures the marcher, not the angular binning.
+// mu = -z / r (REFERENCES.md): in closed form for g = 0 (where the thin table
+// is exact); for g = 0.6 by quadrature of the table's own p (its lookup), so
+// that the test measures the marcher, not the angular binning.
 //
 // Tolerance, derived. The marcher holds the source constant over a voxel,
 // evaluated at its centre: a ray at impact parameter b sees 1/r^2 at points
@@ -57,6 +58,9 @@ void expect_thin_sphere_profile(double g) {
   const double sigma_sct = albedo * kappa, tau_sct = sigma_sct * l;
   auto reference = [&](double b) {
     const double zmax = std::sqrt(radius * radius - b * b);
+    // Isotropic scattering has a closed form: with z = b tan(phi),
+    // int dz / r^2 = 2 arctan(zmax / b) / b and p = 1 / (4 pi).
+    if (g == 0.0) return sigma_sct * power / (4 * kPiD * b) / (4 * kPiD) * 2 * std::atan(zmax / b);
     const int steps = 4000;
     double sum = 0;
     for (int k = 0; k < steps; ++k) {
@@ -280,6 +284,47 @@ TEST(Renderer, SmoothModeConvergesToTheExactTraversal) {
     diff += std::fabs(trilinear.pixels[i] - exact.pixels[i]);
   }
   std::printf("smooth mode (trilinear), step 0.25 voxel: relative L1 difference %.3g\n", diff / norm);
+}
+
+}  // namespace
+}  // namespace nebula
+
+#include "raycast/point_stars.h"
+
+namespace nebula {
+namespace {
+
+// A star seen through a uniform slab dims by exp(-tau_b) per band: the drawn
+// star's total flux (pixels x their solid angle) with and without the slab.
+TEST(PointStars, StarBehindASlabDimsByItsOpticalDepth) {
+  DensityGrid grid = testing::cube(10, 1.0f, 0.0f);
+  CameraSettings cs;
+  cs.position = {0.05f, 0.02f, -5.0f};
+  cs.look_at = {0.05f, 0.02f, 0.0f};
+  cs.fov_deg = 10;
+  cs.width = cs.height = 64;
+  const Camera camera = make_camera(cs);
+  const std::vector<PointStar> stars{{{0.1f, 0.0f, 4.0f}, {1.0f, 2.0f, 3.0f}}};
+  const std::vector<float> ratios{1.3f, 1.0f, 0.8f};
+  auto flux = [&](float tau_v) {
+    std::fill(grid.tau_v.begin(), grid.tau_v.end(), tau_v);
+    Image image(64, 64, {"B", "V", "R"});
+    draw_point_stars(grid, stars, ratios, camera, 1.0f, 1.5, image);
+    std::vector<double> total(3, 0.0);
+    for (int b = 0; b < 3; ++b)
+      for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x) total[b] += image.at(b, x, y);
+    return total;
+  };
+  const std::vector<double> clear = flux(0.0f), dusty = flux(0.3f);
+  // The line of sight crosses the whole slab (10 voxels of tau_v 0.3 along z),
+  // slightly obliquely: the path is longer by |d| / |d_z|.
+  const Vec3 d = stars[0].position - cs.position;
+  const double tau_v = 10 * 0.3 * length(d) / std::fabs(d.z);
+  for (int b = 0; b < 3; ++b) {
+    ASSERT_GT(clear[b], 0.0);
+    EXPECT_NEAR(dusty[b] / clear[b], std::exp(-tau_v * ratios[b]), 1e-4 * std::exp(-tau_v * ratios[b]));
+  }
 }
 
 }  // namespace
