@@ -12,61 +12,15 @@
 #include <vector>
 
 #include "core/error.h"
+#include "hdf5io/hdf5_support.h"
 #include "imageio/image_formats.h"
 
 namespace nebula::imageio_detail {
 
 namespace {
 
-// HDF5 1.10 is not thread-safe unless built so. tables/table_file.cpp keeps
-// its own mutex for the same reason; this one is deliberately separate so the
-// two libraries stay independent. Debian's build is thread-safe, so the two
-// locks not excluding each other is harmless there.
-std::mutex hdf5_mutex;
-
-// Owns an HDF5 identifier and closes it with the matching function.
-class Handle {
- public:
-  using Closer = herr_t (*)(hid_t);
-  Handle(hid_t id, Closer closer) : id_(id), closer_(closer) {}
-  ~Handle() { close(); }
-  Handle(Handle&& other) noexcept : id_(other.id_), closer_(other.closer_) {
-    other.id_ = H5I_INVALID_HID;
-  }
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  bool valid() const { return id_ >= 0; }
-  hid_t get() const { return id_; }
-  // Closes now and says whether it worked (a file close writes it out).
-  bool close() {
-    if (id_ < 0) return true;
-    const herr_t status = closer_(id_);
-    id_ = H5I_INVALID_HID;
-    return status >= 0;
-  }
-
- private:
-  hid_t id_;
-  Closer closer_;
-};
-
-// The innermost entry of HDF5's error stack (often the system call's
-// complaint), or "" when there is none.
-std::string hdf5_reason() {
-  std::string reason;
-  auto take_first = [](unsigned n, const H5E_error2_t* e, void* out) -> herr_t {
-    if (n == 0 && e->desc != nullptr) *static_cast<std::string*>(out) = e->desc;
-    return 0;
-  };
-  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, take_first, &reason);
-  std::replace(reason.begin(), reason.end(), '\n', ' ');
-  return reason;
-}
-
-std::string with_reason(const std::string& what) {
-  const std::string reason = hdf5_reason();
-  return reason.empty() ? what : what + " (" + reason + ")";
-}
+using hdf5io::Handle;
+using hdf5io::with_reason;
 
 // ---------------------------------------------------------------- writing
 
@@ -196,8 +150,8 @@ std::vector<std::string> attribute_names(const std::string& path, hid_t file) {
 }  // namespace
 
 void write_hdf5(const Image& image, const ImageMetadata& metadata, const std::string& file_name) {
-  const std::lock_guard<std::mutex> lock(hdf5_mutex);
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // one line of ours instead of HDF5's stack
+  const std::lock_guard<std::mutex> lock(hdf5io::hdf5_mutex());
+  hdf5io::silence_hdf5_errors();
 
   // The core driver builds the file in memory and writes it out on close:
   // HDF5 1.10 recovers from a failed write there (tables/table_file.cpp has
@@ -244,8 +198,8 @@ void write_hdf5(const Image& image, const ImageMetadata& metadata, const std::st
 }
 
 Image read_hdf5(const std::string& path, ImageMetadata* metadata) {
-  const std::lock_guard<std::mutex> lock(hdf5_mutex);
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  const std::lock_guard<std::mutex> lock(hdf5io::hdf5_mutex());
+  hdf5io::silence_hdf5_errors();
 
   if (H5Fis_hdf5(path.c_str()) <= 0)
     throw Error(path + ": not an HDF5 file (no HDF5 signature); expected a nebula image");

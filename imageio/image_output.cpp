@@ -1,10 +1,6 @@
 #include "imageio/image_output.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <atomic>
 #include <cctype>
 #include <cerrno>
 #include <charconv>
@@ -15,6 +11,7 @@
 #include <regex>
 #include <set>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "imageio/image_formats.h"
 
@@ -202,68 +199,6 @@ void check_metadata(const ImageMetadata& m, const std::string& path) {
   }
 }
 
-// Refuses a target that is a folder, exists (unless overwrite), or whose
-// folder is missing, before anything is created.
-void check_target(const std::string& path, bool overwrite) {
-  const std::string where = "cannot write " + path + ": ";
-  std::error_code ec;
-  const fs::file_status status = fs::status(path, ec);
-  if (fs::is_directory(status)) throw Error(where + "it is a folder");
-  if (fs::exists(status) && !overwrite)
-    throw Error(where + "the file exists (overwriting was not requested)");
-  const fs::path target(path);
-  const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  const fs::file_status folder_status = fs::status(folder, ec);
-  if (!fs::exists(folder_status)) throw Error(where + "folder " + folder.string() + " does not exist");
-  if (!fs::is_directory(folder_status)) throw Error(where + folder.string() + " is not a folder");
-}
-
-// Makes the finished file durable before the rename publishes it; returns
-// errno's text on failure.
-std::string sync_file(const std::string& file_name) {
-  const int fd = ::open(file_name.c_str(), O_WRONLY);
-  if (fd < 0) return std::strerror(errno);
-  if (::fsync(fd) != 0 && errno != EINVAL) {  // EINVAL: a file system without fsync
-    const std::string reason = std::strerror(errno);
-    ::close(fd);
-    return reason;
-  }
-  if (::close(fd) != 0) return std::strerror(errno);
-  return {};
-}
-
-// An empty file PATH.tmp-PID-N beside the target, removed again unless
-// committed. The counter keeps two threads writing the same target apart.
-class TemporaryFile {
- public:
-  explicit TemporaryFile(const std::string& target) {
-    static std::atomic<unsigned> counter{0};
-    path_ = target + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-    // Creating it ourselves gives errno's plain reason ("Permission denied")
-    // rather than whatever the format library would make of it.
-    const int fd = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
-    if (fd < 0) {
-      committed_ = true;  // nothing was created, so nothing to remove
-      throw Error("cannot write " + target + ": " + std::strerror(errno));
-    }
-    ::close(fd);
-  }
-  ~TemporaryFile() {
-    if (!committed_) {
-      std::error_code ignored;
-      fs::remove(path_, ignored);
-    }
-  }
-  TemporaryFile(const TemporaryFile&) = delete;
-  TemporaryFile& operator=(const TemporaryFile&) = delete;
-  const std::string& path() const { return path_; }
-  void commit() { committed_ = true; }
-
- private:
-  std::string path_;
-  bool committed_ = false;
-};
-
 }  // namespace
 
 void write_image(const Image& image, const std::string& path, const ImageMetadata& metadata,
@@ -278,7 +213,7 @@ void write_image(const Image& image, const std::string& path, const ImageMetadat
                 "-DNEBULA_OPENIMAGEIO=ON), use .h5 or .fits");
   check_image(image, path, format);
   check_metadata(metadata, path);
-  check_target(path, overwrite);
+  check_output_target(path, overwrite, "folder", true);
 
   TemporaryFile temporary(path);
   try {
@@ -293,14 +228,7 @@ void write_image(const Image& image, const std::string& path, const ImageMetadat
   } catch (const std::bad_alloc&) {
     throw Error("cannot write " + path + ": out of memory");
   }
-  const std::string failure = sync_file(temporary.path());
-  if (!failure.empty()) throw Error("cannot write " + path + ": " + failure);
-  // rename() replaces atomically; the existence check above has a small race
-  // with other writers, acceptable for files made by one run at a time.
-  std::error_code ec;
-  fs::rename(temporary.path(), path, ec);
-  if (ec) throw Error("cannot write " + path + ": renaming the temporary file failed: " + ec.message());
-  temporary.commit();
+  temporary.publish();
 }
 
 Image read_image(const std::string& path, ImageMetadata* metadata) {

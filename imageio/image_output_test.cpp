@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/test_support.h"
 #include "imageio/tone_map.h"
 
 #ifdef NEBULA_HAVE_OIIO
@@ -32,6 +33,7 @@ namespace nebula {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::expect_error;
 
 // ------------------------------------------------------------- helpers
 
@@ -85,48 +87,15 @@ void expect_same_metadata(const ImageMetadata& a, const ImageMetadata& b) {
   EXPECT_EQ(a.entries, b.entries);
 }
 
-// Calls `action`, which must throw Error with one line containing every piece.
-template <class Action>
-void expect_error(Action action, const std::vector<std::string>& pieces) {
-  try {
-    action();
-    ADD_FAILURE() << "no error; expected one mentioning " << pieces.front();
-  } catch (const Error& e) {
-    const std::string message = e.what();
-    for (const std::string& piece : pieces)
-      EXPECT_NE(message.find(piece), std::string::npos) << "missing '" << piece << "' in: " << message;
-    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
-  }
-}
-
 std::string file_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
 // Each test works in its own fresh folder.
-class ImageFile : public ::testing::Test {
+class ImageFile : public ::testing::Test, protected testing::ScratchDir {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("nebula_imageio_" + std::to_string(::getpid()) + "_" +
-                                        info->test_suite_name() + "_" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    fs::permissions(dir_, fs::perms::owner_all, fs::perm_options::add);
-    fs::remove_all(dir_);
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  std::vector<std::string> files() const {
-    std::vector<std::string> names;
-    for (const auto& entry : fs::directory_iterator(dir_)) names.push_back(entry.path().filename());
-    std::sort(names.begin(), names.end());
-    return names;
-  }
-
-  fs::path dir_;
+  ImageFile() : ScratchDir("nebula_imageio") {}
 };
 
 // ------------------------------------------------------------- round trips
@@ -544,7 +513,7 @@ TEST_F(ImageFile, BadMetadataIsRefused) {
     std::cerr << "left behind: " << entry.path() << "\n";
     code = 3;
   }
-  // The child ran its own SetUp (a folder named by its pid) and skips TearDown.
+  // The child made its own fixture (a folder named by its pid) and skips its destructor.
   std::error_code ignored;
   fs::remove_all(dir, ignored);
   // _Exit, not exit: with OpenImageIO loaded, a library's exit handler in

@@ -1,7 +1,6 @@
 #include "scene/density_sources.h"
 
 #include <fitsio.h>
-#include <hdf5.h>
 #include <unistd.h>
 
 #include <cctype>
@@ -15,16 +14,13 @@
 #include <string>
 
 #include "core/error.h"
+#include "hdf5io/hdf5_support.h"
 
 namespace nebula {
 namespace {
 
-// HDF5 1.10 (serial) and cfitsio (unless built reentrant) must not be
-// entered from two threads at once.
-std::mutex& hdf5_lock() {
-  static std::mutex m;
-  return m;
-}
+// cfitsio (unless built reentrant) must not be entered from two threads at
+// once; HDF5 has the program-wide hdf5io::hdf5_mutex().
 std::mutex& fits_lock() {
   static std::mutex m;
   return m;
@@ -59,22 +55,7 @@ void require_readable(const std::string& path) {
 
 // ---------------------------------------------------------------- HDF5
 
-// An HDF5 identifier closed by its matching function at scope exit.
-class H5Id {
- public:
-  H5Id(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
-  ~H5Id() {
-    if (id_ >= 0) close_(id_);
-  }
-  H5Id(const H5Id&) = delete;
-  H5Id& operator=(const H5Id&) = delete;
-  hid_t operator*() const { return id_; }
-  explicit operator bool() const { return id_ >= 0; }
-
- private:
-  hid_t id_;
-  herr_t (*close_)(hid_t);
-};
+using hdf5io::Handle;
 
 // The object (dataset or root group) that carries `name`, or -1.
 hid_t attribute_holder(hid_t dataset, hid_t file, const char* name) {
@@ -86,19 +67,19 @@ hid_t attribute_holder(hid_t dataset, hid_t file, const char* name) {
 // Reads a numeric attribute of exactly `count` elements as doubles.
 std::vector<double> read_numeric_attribute(hid_t holder, const char* name, size_t count,
                                            const std::string& what) {
-  H5Id attr(H5Aopen(holder, name, H5P_DEFAULT), H5Aclose);
-  if (!attr) throw Error(what + ": cannot open attribute '" + name + "'");
-  H5Id type(H5Aget_type(*attr), H5Tclose);
-  const H5T_class_t cls = H5Tget_class(*type);
+  Handle attr(H5Aopen(holder, name, H5P_DEFAULT), H5Aclose);
+  if (!attr.valid()) throw Error(what + ": cannot open attribute '" + name + "'");
+  Handle type(H5Aget_type(attr.get()), H5Tclose);
+  const H5T_class_t cls = H5Tget_class(type.get());
   if (cls != H5T_FLOAT && cls != H5T_INTEGER)
     throw Error(what + ": attribute '" + name + "' must be numeric");
-  H5Id space(H5Aget_space(*attr), H5Sclose);
-  const hssize_t n = H5Sget_simple_extent_npoints(*space);
+  Handle space(H5Aget_space(attr.get()), H5Sclose);
+  const hssize_t n = H5Sget_simple_extent_npoints(space.get());
   if (n != static_cast<hssize_t>(count))
     throw Error(what + ": attribute '" + name + "' must have " + std::to_string(count) +
                 (count == 1 ? " value" : " values") + ", found " + std::to_string(n));
   std::vector<double> values(count);
-  if (H5Aread(*attr, H5T_NATIVE_DOUBLE, values.data()) < 0)
+  if (H5Aread(attr.get(), H5T_NATIVE_DOUBLE, values.data()) < 0)
     throw Error(what + ": cannot read attribute '" + name + "'");
   return values;
 }
@@ -125,25 +106,25 @@ struct Hdf5Grid {
 Hdf5Grid read_hdf5_grid(const std::string& path, const std::string& dataset) {
   require_readable(path);
   const std::string what = path + ": dataset '" + dataset + "'";
-  std::lock_guard<std::mutex> lock(hdf5_lock());
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // we report one line instead
+  std::lock_guard<std::mutex> lock(hdf5io::hdf5_mutex());
+  hdf5io::silence_hdf5_errors();
   if (H5Fis_hdf5(path.c_str()) <= 0) throw Error(path + ": not an HDF5 file");
-  H5Id file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
-  if (!file) throw Error(path + ": cannot open as HDF5");
-  if (dataset.empty() || H5Lexists(*file, dataset.c_str(), H5P_DEFAULT) <= 0)
-    throw Error(what + " not found (the file holds: " + root_names(*file) + ")");
-  H5Id set(H5Dopen2(*file, dataset.c_str(), H5P_DEFAULT), H5Dclose);
-  if (!set) throw Error(what + ": not a dataset");
-  H5Id type(H5Dget_type(*set), H5Tclose);
-  const H5T_class_t cls = H5Tget_class(*type);
+  Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  if (!file.valid()) throw Error(path + ": cannot open as HDF5");
+  if (dataset.empty() || H5Lexists(file.get(), dataset.c_str(), H5P_DEFAULT) <= 0)
+    throw Error(what + " not found (the file holds: " + root_names(file.get()) + ")");
+  Handle set(H5Dopen2(file.get(), dataset.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!set.valid()) throw Error(what + ": not a dataset");
+  Handle type(H5Dget_type(set.get()), H5Tclose);
+  const H5T_class_t cls = H5Tget_class(type.get());
   if (cls != H5T_FLOAT && cls != H5T_INTEGER)
     throw Error(what + ": must hold numbers (float or integer)");
-  H5Id space(H5Dget_space(*set), H5Sclose);
-  const int rank = H5Sget_simple_extent_ndims(*space);
+  Handle space(H5Dget_space(set.get()), H5Sclose);
+  const int rank = H5Sget_simple_extent_ndims(space.get());
   if (rank != 3)
     throw Error(what + ": must be 3-D [nz][ny][nx], found " + std::to_string(rank) + "-D");
   hsize_t dims[3] = {0, 0, 0};
-  H5Sget_simple_extent_dims(*space, dims, nullptr);
+  H5Sget_simple_extent_dims(space.get(), dims, nullptr);
   check_grid_size(what, dims[2], dims[1], dims[0]);
   if (dims[0] > uint64_t(std::numeric_limits<int>::max()) ||
       dims[1] > uint64_t(std::numeric_limits<int>::max()) ||
@@ -154,7 +135,7 @@ Hdf5Grid read_hdf5_grid(const std::string& path, const std::string& dataset) {
   grid.shape.nx = static_cast<int>(dims[2]);
   grid.shape.ny = static_cast<int>(dims[1]);
   grid.shape.nz = static_cast<int>(dims[0]);
-  const hid_t voxel_holder = attribute_holder(*set, *file, "voxel_size");
+  const hid_t voxel_holder = attribute_holder(set.get(), file.get(), "voxel_size");
   if (voxel_holder >= 0) {
     const double voxel = read_numeric_attribute(voxel_holder, "voxel_size", 1, what)[0];
     if (!(voxel > 0) || !std::isfinite(voxel) || !(static_cast<float>(voxel) > 0) ||
@@ -164,7 +145,7 @@ Hdf5Grid read_hdf5_grid(const std::string& path, const std::string& dataset) {
     grid.shape.voxel = static_cast<float>(voxel);
     grid.has_voxel = true;
   }
-  const hid_t origin_holder = attribute_holder(*set, *file, "origin");
+  const hid_t origin_holder = attribute_holder(set.get(), file.get(), "origin");
   if (origin_holder >= 0) {
     const std::vector<double> o = read_numeric_attribute(origin_holder, "origin", 3, what);
     for (double v : o)
@@ -178,7 +159,7 @@ Hdf5Grid read_hdf5_grid(const std::string& path, const std::string& dataset) {
     throw Error(what + ": out of memory allocating " +
                 bytes_text(double(grid.shape.count()) * sizeof(float)));
   }
-  if (H5Dread(*set, H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, grid.values.data()) < 0)
+  if (H5Dread(set.get(), H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, grid.values.data()) < 0)
     throw Error(what + ": cannot read the values");
   return grid;
 }

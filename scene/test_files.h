@@ -1,6 +1,6 @@
 #pragma once
-// Test helpers for scene/: a fresh temporary folder per test, and writers of
-// small HDF5 and FITS grids through the libraries' C APIs.
+// Test helpers for scene/: a fresh temporary folder per test (core/test_support.h),
+// and writers of small HDF5 and FITS grids through the libraries' C APIs.
 #include <fitsio.h>
 #include <gtest/gtest.h>
 #include <hdf5.h>
@@ -14,38 +14,15 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/test_support.h"
 
 namespace nebula::testing {
 
 namespace fs = std::filesystem;
 
-// Calls `action`, which must throw Error with one line containing every piece.
-template <class Action>
-void expect_error(Action action, const std::vector<std::string>& pieces) {
-  try {
-    action();
-    ADD_FAILURE() << "no error; expected one mentioning " << pieces.front();
-  } catch (const Error& e) {
-    const std::string message = e.what();
-    for (const std::string& piece : pieces)
-      EXPECT_NE(message.find(piece), std::string::npos)
-          << "missing '" << piece << "' in: " << message;
-    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
-  }
-}
-
-class TempDirTest : public ::testing::Test {
+class TempDirTest : public ::testing::Test, protected ScratchDir {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("nebula_scene_" + std::to_string(::getpid()) + "_" +
-                                        info->test_suite_name() + "_" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  TempDirTest() : ScratchDir("nebula_scene") {}
 
   std::string write_text(const std::string& name, const std::string& text) const {
     const std::string p = path(name);
@@ -53,8 +30,6 @@ class TempDirTest : public ::testing::Test {
     std::ofstream(p, std::ios::binary) << text;
     return p;
   }
-
-  fs::path dir_;
 };
 
 struct H5Dataset {

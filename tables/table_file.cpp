@@ -1,9 +1,5 @@
 #include "tables/table_file.h"
 
-#include <fcntl.h>
-#include <hdf5.h>
-#include <unistd.h>
-
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -13,7 +9,9 @@
 #include <new>
 #include <vector>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
+#include "hdf5io/hdf5_support.h"
 
 namespace nebula {
 
@@ -21,65 +19,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The serial HDF5 library must not be entered from two threads at once.
-std::mutex hdf5_mutex;
+using hdf5io::Handle;
+using hdf5io::with_reason;
 
 // Largest dataset we agree to allocate for; a malformed file claiming more is
 // refused instead of exhausting memory.
 constexpr hsize_t kMaxElements = hsize_t(1) << 28;
-
-// Owns an HDF5 identifier and closes it with the matching function.
-class Handle {
- public:
-  using Closer = herr_t (*)(hid_t);
-  Handle(hid_t id, Closer closer) : id_(id), closer_(closer) {}
-  ~Handle() { close(); }
-  Handle(Handle&& other) noexcept : id_(other.id_), closer_(other.closer_) {
-    other.id_ = H5I_INVALID_HID;
-  }
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-
-  bool valid() const { return id_ >= 0; }
-  hid_t get() const { return id_; }
-  // Closes now and says whether it worked (a file close flushes to disk).
-  bool close() {
-    if (id_ < 0) return true;
-    const herr_t status = closer_(id_);
-    id_ = H5I_INVALID_HID;
-    return status >= 0;
-  }
-
- private:
-  hid_t id_;
-  Closer closer_;
-};
-
-// The innermost entry of HDF5's error stack, usually the system call's
-// complaint ("File too large"); empty when the stack says nothing useful.
-std::string hdf5_reason() {
-  std::string reason;
-  auto take_first = [](unsigned n, const H5E_error2_t* e, void* out) -> herr_t {
-    if (n == 0 && e->desc != nullptr) *static_cast<std::string*>(out) = e->desc;
-    return 0;
-  };
-  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, take_first, &reason);
-  const std::string marker = "error message = '";
-  const size_t at = reason.find(marker);
-  if (at != std::string::npos) {
-    const size_t begin = at + marker.size();
-    reason = reason.substr(begin, reason.find('\'', begin) - begin);
-  }
-  return reason;
-}
-
-std::string with_reason(const std::string& what) {
-  const std::string reason = hdf5_reason();
-  return reason.empty() ? what : what + " (" + reason + ")";
-}
-
-// HDF5 prints its error stack to stderr by default; we report one line instead.
-void silence_hdf5() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
 
 const char* class_name(H5T_class_t c) {
   switch (c) {
@@ -189,40 +134,6 @@ void write_hdf5(const ScatteringTable& t, const std::string& file_name) {
 
   if (!file.close()) throw Error(with_reason("writing the HDF5 file"));
 }
-
-// Makes the finished file durable before the rename publishes it; returns
-// errno's text on failure.
-std::string sync_file(const std::string& file_name) {
-  const int fd = ::open(file_name.c_str(), O_WRONLY);
-  if (fd < 0) return std::strerror(errno);
-  if (::fsync(fd) != 0 && errno != EINVAL) {  // EINVAL: a file system without fsync
-    const std::string reason = std::strerror(errno);
-    ::close(fd);
-    return reason;
-  }
-  if (::close(fd) != 0) return std::strerror(errno);
-  return {};
-}
-
-// Removes the temporary file unless the write was committed.
-class TemporaryFile {
- public:
-  explicit TemporaryFile(std::string path) : path_(std::move(path)) {}
-  ~TemporaryFile() {
-    if (!committed_) {
-      std::error_code ignored;
-      fs::remove(path_, ignored);
-    }
-  }
-  TemporaryFile(const TemporaryFile&) = delete;
-  TemporaryFile& operator=(const TemporaryFile&) = delete;
-  const std::string& path() const { return path_; }
-  void commit() { committed_ = true; }
-
- private:
-  std::string path_;
-  bool committed_ = false;
-};
 
 // ---------------------------------------------------------------- reading
 
@@ -429,45 +340,25 @@ ScatteringTable read_hdf5(const std::string& path, hid_t file) {
 
 void write_table(const ScatteringTable& table, const std::string& path, bool overwrite) {
   table.check_consistency(path);
-  const std::lock_guard<std::mutex> lock(hdf5_mutex);
-  silence_hdf5();
+  const std::lock_guard<std::mutex> lock(hdf5io::hdf5_mutex());
+  hdf5io::silence_hdf5_errors();
 
-  std::error_code ec;
-  const fs::file_status status = fs::status(path, ec);
-  if (fs::is_directory(status)) throw Error("cannot write " + path + ": it is a directory");
-  if (fs::exists(status) && !overwrite)
-    throw Error("cannot write " + path + ": the file exists (overwriting was not requested)");
+  check_output_target(path, overwrite, "directory", false);
 
-  // Create the temporary file ourselves first: errno gives a plain reason
-  // ("Permission denied") that HDF5 would bury in its error stack.
-  TemporaryFile temporary(path + ".tmp-" + std::to_string(::getpid()));
-  const int fd = ::open(temporary.path().c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  if (fd < 0) {
-    const std::string reason = std::strerror(errno);
-    temporary.commit();  // nothing was created, so nothing to remove
-    throw Error("cannot write " + path + ": " + reason);
-  }
-  ::close(fd);
-
+  TemporaryFile temporary(path);
   try {
     write_hdf5(table, temporary.path());
   } catch (const Error& e) {
     throw Error("cannot write " + path + ": " + e.what());
   }
-  const std::string failure = sync_file(temporary.path());
-  if (!failure.empty()) throw Error("cannot write " + path + ": " + failure);
-  // rename() replaces atomically; the existence check above has a small race
-  // with other writers, acceptable for files made by one run at a time.
-  fs::rename(temporary.path(), path, ec);
-  if (ec) throw Error("cannot write " + path + ": renaming the temporary file failed: " + ec.message());
-  temporary.commit();
+  temporary.publish();
 }
 
 ScatteringTable read_table(const std::string& path) {
   ScatteringTable table;
   {
-    const std::lock_guard<std::mutex> lock(hdf5_mutex);
-    silence_hdf5();
+    const std::lock_guard<std::mutex> lock(hdf5io::hdf5_mutex());
+    hdf5io::silence_hdf5_errors();
 
     std::error_code ec;
     const fs::file_status status = fs::status(path, ec);

@@ -18,12 +18,14 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/test_support.h"
 #include "tables/test_tables.h"
 
 namespace nebula {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::expect_error;
 using testing::make_test_table;
 
 void expect_same_table(const ScatteringTable& a, const ScatteringTable& b) {
@@ -55,43 +57,10 @@ void expect_same_table(const ScatteringTable& a, const ScatteringTable& b) {
   EXPECT_EQ(a.unscattered, b.unscattered);
 }
 
-// Calls `action`, which must throw Error with one line containing every piece.
-template <class Action>
-void expect_error(Action action, const std::vector<std::string>& pieces) {
-  try {
-    action();
-    ADD_FAILURE() << "no error; expected one mentioning " << pieces.front();
-  } catch (const Error& e) {
-    const std::string message = e.what();
-    for (const std::string& piece : pieces)
-      EXPECT_NE(message.find(piece), std::string::npos) << "missing '" << piece << "' in: " << message;
-    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
-  }
-}
-
 // Each test works in its own fresh directory.
-class TableFile : public ::testing::Test {
+class TableFile : public ::testing::Test, protected testing::ScratchDir {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("nebula_tables_" + std::to_string(::getpid()) + "_" + info->test_suite_name() + "_" +
-            info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    fs::permissions(dir_, fs::perms::owner_all, fs::perm_options::add);
-    fs::remove_all(dir_);
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  std::vector<std::string> files() const {
-    std::vector<std::string> names;
-    for (const auto& entry : fs::directory_iterator(dir_)) names.push_back(entry.path().filename());
-    return names;
-  }
-
-  fs::path dir_;
+  TableFile() : ScratchDir("nebula_tables") {}
 };
 
 TEST_F(TableFile, RoundTripPreservesEveryField) {
