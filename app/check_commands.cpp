@@ -189,7 +189,7 @@ void add_bench_command(CLI::App& app) {
     }
   });
 
-  auto* rend = cmd->add_subcommand("render", "frames of a noisy dust ball, 1 to N stars, CPU and CUDA");
+  auto* rend = cmd->add_subcommand("render", "frames of the procedural nebula, 1 to N stars, CPU and CUDA");
   struct RenderOptions {
     std::string backends = "auto";
     int size = 256, width = 1920, height = 1080, stars = 8, repeats = 5;

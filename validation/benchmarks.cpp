@@ -6,6 +6,7 @@
 #include "core/philox.h"
 #include "illumination/optical_depth_bake.h"
 #include "raycast/renderer.h"
+#include "scene/density_sources.h"
 #include "tables/scattering_table.h"
 
 namespace nebula {
@@ -108,18 +109,12 @@ BakeBenchResult bench_bake(Backend backend, int size, int stars, int repeats) {
 
 std::vector<RenderBenchRow> bench_render(Backend backend, int size, int width, int height, int max_stars,
                                          int repeats) {
-  DensityGrid grid;
-  grid.shape.nx = grid.shape.ny = grid.shape.nz = size;
-  grid.shape.voxel = 2.0f / size;
-  grid.shape.origin = {-1, -1, -1};
-  grid.tau_v.resize(grid.shape.count());
-  for (int z = 0; z < size; ++z)
-    for (int y = 0; y < size; ++y)
-      for (int x = 0; x < size; ++x) {
-        const size_t c = grid.shape.index(x, y, z);
-        const float r = length(grid.shape.centre(x, y, z));
-        grid.tau_v[c] = r < 0.95f ? 0.5f * philox_uniform4(41, 0, uint32_t(c), 0, 0).u0 : 0.0f;
-      }
+  // The procedural nebula of the 2005 paper's section 4.3 (scene/), its
+  // default parameters at size^3 voxels over a 2 pc cube.
+  ProceduralParams pp;
+  pp.n = size;
+  const DensityGrid grid = procedural_nebula(pp);
+  const Vec3 centre = procedural_star_position(pp);
   TabulateParams tp;
   tp.photons_per_row = 10000;
   tp.binning = AngularBinning::UniformTheta;
@@ -128,8 +123,8 @@ std::vector<RenderBenchRow> bench_render(Backend backend, int size, int width, i
   for (size_t e = 0; e < tab.P.size(); ++e) table.P[e] = static_cast<float>(tab.P[e]);
 
   CameraSettings cs;
-  cs.position = {0.4f, -3.2f, 1.1f};
-  cs.look_at = {0, 0, 0};
+  cs.position = centre + Vec3{0.4f, -3.2f, 1.1f};
+  cs.look_at = centre;
   cs.up = {0, 0, 1};
   cs.fov_deg = 45;
   cs.width = width;
@@ -138,7 +133,9 @@ std::vector<RenderBenchRow> bench_render(Backend backend, int size, int width, i
   for (int stars = 1; stars <= max_stars; stars *= 2) {
     std::vector<Vec3> positions;
     for (int k = 0; k < stars; ++k)
-      positions.push_back({0.5f * std::cos(1.3f * k), 0.5f * std::sin(1.3f * k), 0.2f * k - 0.4f});
+      positions.push_back(k == 0 ? centre
+                                 : centre + Vec3{0.5f * std::cos(1.3f * k), 0.5f * std::sin(1.3f * k),
+                                                 0.1f * k - 0.4f});
     const BakeResult bake = bake_star_depths(grid, positions, backend);
     RenderInputs in;
     in.density = &grid;

@@ -58,9 +58,10 @@ struct RenderBenchRow {
   double rays_per_second = 0;
 };
 
-// Frames of a size^3 noisy dust ball (tau_v up to 0.5 per voxel) lit by 1, 2,
-// 4, ... `max_stars` stars, seen from outside with a perspective camera, with
-// a table tabulated on the same backend (a = g = 0.6, 10^4 photons per row).
+// Frames of the procedural nebula (scene/, default parameters, size^3
+// voxels) lit by 1, 2, 4, ... `max_stars` stars (the first at the nebula's
+// star), seen from outside with a perspective camera, with a table tabulated
+// on the same backend (a = g = 0.6, 10^4 photons per row).
 std::vector<RenderBenchRow> bench_render(Backend backend, int size, int width, int height, int max_stars,
                                          int repeats);
 
