@@ -46,8 +46,12 @@ NEBULA_HD bool clip_to_grid(const GridShape& g, Vec3 a, Vec3 dir, float len, flo
   return t0 < t1;
 }
 
+// As traverse_segment, but the visitor also receives the voxel's integer
+// coordinates: visit(x, y, z, voxel_index, length). Callers that need the
+// voxel's position use these instead of dividing the index (64-bit integer
+// division is slow on a GPU).
 template <class Visit>
-NEBULA_HD void traverse_segment(const GridShape& g, Vec3 a, Vec3 b, Visit&& visit) {
+NEBULA_HD void traverse_segment_cells(const GridShape& g, Vec3 a, Vec3 b, Visit&& visit) {
   const Vec3 d = b - a;
   const float len = length(d);
   if (!(len > 0.0f)) return;
@@ -88,10 +92,10 @@ NEBULA_HD void traverse_segment(const GridShape& g, Vec3 a, Vec3 b, Visit&& visi
   for (int guard = n[0] + n[1] + n[2] + 3; guard > 0; --guard) {
     const int k = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
     const float t_next = fminf(fmaxf(t_max[k], t), t1);
-    if constexpr (std::is_same_v<decltype(visit(size_t(0), 0.0f)), bool>) {
-      if (!visit(g.index(cell[0], cell[1], cell[2]), t_next - t)) return;
+    if constexpr (std::is_same_v<decltype(visit(0, 0, 0, size_t(0), 0.0f)), bool>) {
+      if (!visit(cell[0], cell[1], cell[2], g.index(cell[0], cell[1], cell[2]), t_next - t)) return;
     } else {
-      visit(g.index(cell[0], cell[1], cell[2]), t_next - t);
+      visit(cell[0], cell[1], cell[2], g.index(cell[0], cell[1], cell[2]), t_next - t);
     }
     t = t_next;
     if (t >= t1) return;
@@ -99,6 +103,11 @@ NEBULA_HD void traverse_segment(const GridShape& g, Vec3 a, Vec3 b, Visit&& visi
     if (cell[k] < 0 || cell[k] >= n[k]) return;
     t_max[k] += t_delta[k];
   }
+}
+
+template <class Visit>
+NEBULA_HD void traverse_segment(const GridShape& g, Vec3 a, Vec3 b, Visit&& visit) {
+  traverse_segment_cells(g, a, b, [&](int, int, int, size_t cell, float chord) { return visit(cell, chord); });
 }
 
 // V-band extinction optical depth along segment a -> b (tau_v per voxel edge,

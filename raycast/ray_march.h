@@ -56,20 +56,20 @@ NEBULA_HD void scattered_source(const MarchScene& s, Vec3 pos, float tau_v, Vec3
     // theta: between the light's direction (star to dust) and the way to the eye.
     const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
     const float depth = depth_of(k);
+    float u = TableView::kNoAngle;  // the angle's bin coordinate, shared by bands with equal binning
+    int u_from = -1;
     for (int b = 0; b < s.n_bands; ++b) {
       if (!(s.albedo[b] > 0.0f)) continue;
+      if (u_from < 0 || s.table[b].bins.kind != s.table[u_from].bins.kind ||
+          s.table[b].bins.n != s.table[u_from].bins.n) {
+        u = s.table[b].angle_coordinate(mu);
+        u_from = b;
+      }
       const float tau_b = tau_v * s.extinction_ratio[b];
       const float e = star_irradiance(star.power[b], r, s.density.shape.voxel, depth * s.extinction_ratio[b]);
-      source[b] += e * s.table[b].lookup(s.albedo[b] * tau_b, mu, clamps);
+      source[b] += e * s.table[b].lookup_at(s.albedo[b] * tau_b, u, clamps);
     }
   }
-}
-
-NEBULA_HD Vec3 voxel_centre(const GridShape& g, size_t cell) {
-  const int x = static_cast<int>(cell % g.nx);
-  const int y = static_cast<int>((cell / g.nx) % g.ny);
-  const int z = static_cast<int>(cell / (size_t(g.nx) * g.ny));
-  return g.centre(x, y, z);
 }
 
 // A cell-centred field at `pos`: trilinear (clamped at the grid's edge) or
@@ -130,7 +130,7 @@ NEBULA_HD RayResult march_ray_in_mode(const MarchScene& s, Vec3 origin, Vec3 dir
   const float step = mode.step_voxels * g.voxel;
   const Vec3 to_eye = -dir;
   float t = t_enter;  // where the current voxel begins along the ray
-  traverse_segment(g, origin, origin + far * dir, [&](size_t cell, float chord) -> bool {
+  traverse_segment_cells(g, origin, origin + far * dir, [&](int x, int y, int z, size_t cell, float chord) -> bool {
     const float tau_v = s.density.tau_v[cell];
     float source[kMaxBands] = {};
     if constexpr (kSmooth) {
@@ -141,7 +141,7 @@ NEBULA_HD RayResult march_ray_in_mode(const MarchScene& s, Vec3 origin, Vec3 dir
         if (ts >= t + chord || ts >= t_exit) break;
         // Trilinear fields are smooth, so is their geometry; voxel values keep
         // the voxel centre's, as the exact traversal does.
-        const Vec3 pos = mode.trilinear ? origin + ts * dir : voxel_centre(g, cell);
+        const Vec3 pos = mode.trilinear ? origin + ts * dir : g.centre(x, y, z);
         float local[kMaxBands] = {};
         for (int b = 0; b < s.n_bands; ++b)
           local[b] = s.emission[b] ? sample_field(g, s.emission[b], pos, mode.trilinear) : 0.0f;
@@ -153,7 +153,7 @@ NEBULA_HD RayResult march_ray_in_mode(const MarchScene& s, Vec3 origin, Vec3 dir
     } else {
       for (int b = 0; b < s.n_bands; ++b) source[b] = s.emission[b] ? s.emission[b][cell] : 0.0f;
       if (tau_v > 0.0f && s.n_stars > 0) {
-        scattered_source(s, voxel_centre(g, cell), tau_v, to_eye,
+        scattered_source(s, g.centre(x, y, z), tau_v, to_eye,
                          [&](int k_star) { return s.stars[k_star].depth_v[cell]; }, source,
                          &out.table_clamps);
       }

@@ -24,6 +24,19 @@ struct TableView {
   // negative or NaN tau_sct, or a NaN mu is clamped to the table and counted
   // once in *clamped, so callers can report how often they left the table.
   NEBULA_HD float lookup(float tau_sct, float mu, int* clamped = nullptr) const {
+    return lookup_at(tau_sct, angle_coordinate(mu), clamped);
+  }
+
+  // The continuous bin-centre index of mu (kNoAngle for a NaN mu). Callers
+  // looking up several rows at one angle (bands) compute it once: for
+  // uniform-theta bins it costs an acos.
+  static constexpr float kNoAngle = -1.0f;
+  NEBULA_HD float angle_coordinate(float mu) const {
+    return mu == mu ? bins.position(mu) - 0.5f : kNoAngle;
+  }
+
+  // lookup() with the angle given as angle_coordinate(mu).
+  NEBULA_HD float lookup_at(float tau_sct, float u, int* clamped = nullptr) const {
     if (P == nullptr || n_tau < 1 || n_mu < 1) return 0.0f;
     bool outside = false;
     float tau = tau_sct;
@@ -34,10 +47,8 @@ struct TableView {
       tau = tau_max;
       outside = true;
     }
-    float u = 0.0f;
-    if (mu == mu) {
-      u = bins.position(mu) - 0.5f;  // continuous bin-centre index
-    } else {
+    if (u < -0.75f) {  // kNoAngle: positions are never below -0.5
+      u = 0.0f;
       outside = true;
     }
     if (outside && clamped != nullptr) *clamped += 1;
