@@ -32,12 +32,6 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 Camera camera_of(const CameraSpec& c) {
   CameraSettings s;
   s.projection = c.kind == CameraKind::Perspective    ? Projection::Perspective
@@ -113,10 +107,10 @@ void run_render(const Options& o) {
       if (!file.empty()) {
         auto t = std::make_shared<ScatteringTable>(read_table(file));
         if (std::fabs(t->albedo - a) > 1e-9 || std::fabs(t->g - g) > 1e-9)
-          throw Error(file + ": albedo " + num(t->albedo) + ", g " + num(t->g) + " but band " + scene.bands[b] +
-                      " of " + scene.path + " asks for albedo " + num(a) + ", g " + num(g));
+          throw Error(file + ": albedo " + to_text(t->albedo) + ", g " + to_text(t->g) + " but band " + scene.bands[b] +
+                      " of " + scene.path + " asks for albedo " + to_text(a) + ", g " + to_text(g));
         tables[key] = t;
-        computed.push_back("table a=" + num(a) + " g=" + num(g) + ": read " + file);
+        computed.push_back("table a=" + to_text(a) + " g=" + to_text(g) + ": read " + file);
       } else {
         TabulateParams p;
         p.albedo = a;
@@ -125,7 +119,7 @@ void run_render(const Options& o) {
         p.photons_per_row = photons;
         std::string origin;
         tables[key] = std::make_shared<ScatteringTable>(cached_table(p, backend, o.quiet, &origin));
-        computed.push_back("table a=" + num(a) + " g=" + num(g) + ": " + origin + " (" + table_cache_dir() + ")");
+        computed.push_back("table a=" + to_text(a) + " g=" + to_text(g) + ": " + origin + " (" + table_cache_dir() + ")");
       }
     }
     band_table[b] = tables[key].get();
@@ -152,7 +146,7 @@ void run_render(const Options& o) {
     bake = bake_star_depths(scene.density, positions, backend, progress.get());
     if (progress) progress->finish();
     computed.push_back("bake: " + std::to_string(positions.size()) + " star(s) x " +
-                       std::to_string(scene.density.shape.count()) + " voxels, " + num(seconds_since(t0)) + " s");
+                       std::to_string(scene.density.shape.count()) + " voxels, " + to_text(seconds_since(t0)) + " s");
   } else {
     computed.push_back("bake: skipped (no scattering band or no star)");
   }
@@ -185,15 +179,15 @@ void run_render(const Options& o) {
   meta.units = "L_sun pc^-2 sr^-1 x exposure";
   meta.exposure = 1.0;  // the camera exposure is already in the pixels
   for (size_t b = 0; b < n_bands; ++b) {
-    meta.entries.push_back({"albedo_" + scene.bands[b], num(scene.dust.albedo[b])});
-    meta.entries.push_back({"g_" + scene.bands[b], num(scene.dust.g[b])});
-    meta.entries.push_back({"ext_" + scene.bands[b], num(ratios[b])});
+    meta.entries.push_back({"albedo_" + scene.bands[b], to_text(scene.dust.albedo[b])});
+    meta.entries.push_back({"g_" + scene.bands[b], to_text(scene.dust.g[b])});
+    meta.entries.push_back({"ext_" + scene.bands[b], to_text(ratios[b])});
   }
-  meta.entries.push_back({"R_V", num(scene.dust.R_V)});
+  meta.entries.push_back({"R_V", to_text(scene.dust.R_V)});
   meta.entries.push_back({"camera", std::string(to_string(scene.camera.kind)) + " " + std::to_string(camera.width) +
                                         "x" + std::to_string(camera.height)});
   meta.entries.push_back({"scene", scene.path});
-  meta.entries.push_back({"mode", o.smooth > 0 ? "smooth step " + num(o.smooth) + " voxel" : "exact"});
+  meta.entries.push_back({"mode", o.smooth > 0 ? "smooth step " + to_text(o.smooth) + " voxel" : "exact"});
   write_image(image, out, meta, o.force);
 
   std::printf("rendered %s: %dx%d %s, %zu band(s), %zu star(s), grid %dx%dx%d, %s traversal, %s\n",

@@ -9,12 +9,6 @@
 namespace nebula {
 namespace {
 
-std::string number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.6g", v);
-  return text;
-}
-
 // Horner evaluation of c[0] + c[1] y + ... + c[n-1] y^(n-1).
 template <size_t N>
 double polynomial(const double (&c)[N], double y) {
@@ -36,8 +30,8 @@ constexpr double kODonnellB[] = {0.0,    1.952, 2.908,   -3.989, -7.985,
 
 void check_R_V(double R_V) {
   if (!(R_V >= kMinRV && R_V <= kMaxRV))
-    throw Error("R_V = " + number(R_V) + " is outside the extinction law's range [" +
-                number(kMinRV) + ", " + number(kMaxRV) + "]");
+    throw Error("R_V = " + to_text(R_V) + " is outside the extinction law's range [" +
+                to_text(kMinRV) + ", " + to_text(kMaxRV) + "]");
 }
 
 }  // namespace
@@ -48,12 +42,12 @@ const char* to_string(ExtinctionLaw law) {
 
 ExtinctionCoefficients extinction_coefficients(double x, ExtinctionLaw law) {
   if (!(x >= kExtinctionMinInverseMicron && x <= kExtinctionMaxInverseMicron))
-    throw Error("wavelength " + number(1000.0 / x) + " nm (x = " + number(x) +
+    throw Error("wavelength " + to_text(1000.0 / x) + " nm (x = " + to_text(x) +
                 " 1/um) is outside the extinction law's range x in [" +
-                number(kExtinctionMinInverseMicron) + ", " +
-                number(kExtinctionMaxInverseMicron) + "] 1/um (" +
-                number(1000.0 / kExtinctionMaxInverseMicron) + " to " +
-                number(1000.0 / kExtinctionMinInverseMicron) + " nm)");
+                to_text(kExtinctionMinInverseMicron) + ", " +
+                to_text(kExtinctionMaxInverseMicron) + "] 1/um (" +
+                to_text(1000.0 / kExtinctionMaxInverseMicron) + " to " +
+                to_text(1000.0 / kExtinctionMinInverseMicron) + " nm)");
   if (x < 1.1) {
     const double power = std::pow(x, 1.61);  // CCM 1989 infrared power law
     return {0.574 * power, -0.527 * power};
@@ -66,7 +60,7 @@ ExtinctionCoefficients extinction_coefficients(double x, ExtinctionLaw law) {
 double extinction_ratio_at(double wavelength_nm, double R_V, ExtinctionLaw law) {
   check_R_V(R_V);
   if (!(wavelength_nm > 0.0) || !std::isfinite(wavelength_nm))
-    throw Error("wavelength " + number(wavelength_nm) + " nm is not a positive finite number");
+    throw Error("wavelength " + to_text(wavelength_nm) + " nm is not a positive finite number");
   const ExtinctionCoefficients c = extinction_coefficients(1000.0 / wavelength_nm, law);
   return c.a + c.b / R_V;
 }
@@ -78,7 +72,7 @@ double band_extinction_ratio(const Passband& passband, double R_V, ExtinctionLaw
   const double weight = passband_integral(passband, source, kPassbandSubdivisions);
   if (!(weight > 0.0))
     throw Error("passband '" + passband.name + "': the weight integral of T S is " +
-                number(weight) + ", not positive");
+                to_text(weight) + ", not positive");
   const double extinction = passband_integral(
       passband,
       [&](double lambda) { return source(lambda) * extinction_ratio_at(lambda, R_V, law); },

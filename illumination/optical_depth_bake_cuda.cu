@@ -3,6 +3,7 @@
 #include <cuda_runtime.h>
 
 #include "core/cuda_check.h"
+#include "core/cuda_timer.h"
 #include "illumination/optical_depth_bake.h"
 
 namespace nebula {
@@ -30,21 +31,12 @@ BakeResult bake_star_depths_cuda(const DensityGrid& grid, const std::vector<Vec3
     NEBULA_CUDA_CHECK(cudaMemcpy(d_tau, grid.tau_v.data(), bytes, cudaMemcpyHostToDevice));
     const DensityView view{g, d_tau};
     const dim3 block(32, 8), blocks((g.nx + 31) / 32, (g.ny + 7) / 8, g.nz);
-    cudaEvent_t start, stop;
-    NEBULA_CUDA_CHECK(cudaEventCreate(&start));
-    NEBULA_CUDA_CHECK(cudaEventCreate(&stop));
-    NEBULA_CUDA_CHECK(cudaEventRecord(start));
+    CudaEventTimer timer;
     for (size_t s = 0; s < stars.size(); ++s) {
       bake_kernel<<<blocks, block>>>(view, stars[s], d_depth + s * g.count());
       NEBULA_CUDA_CHECK(cudaGetLastError());
     }
-    NEBULA_CUDA_CHECK(cudaEventRecord(stop));
-    NEBULA_CUDA_CHECK(cudaEventSynchronize(stop));
-    float ms = 0;
-    NEBULA_CUDA_CHECK(cudaEventElapsedTime(&ms, start, stop));
-    cudaEventDestroy(start);
-    cudaEventDestroy(stop);
-    out.seconds = ms * 1e-3;
+    out.seconds = timer.seconds();
     out.tau_v.assign(stars.size(), std::vector<float>(g.count()));
     for (size_t s = 0; s < stars.size(); ++s)
       NEBULA_CUDA_CHECK(cudaMemcpy(out.tau_v[s].data(), d_depth + s * g.count(), bytes,

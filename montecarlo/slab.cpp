@@ -12,24 +12,18 @@
 namespace nebula {
 namespace {
 
-std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 }  // namespace
 
 void validate(const SlabParams& p) {
   if (!(p.albedo >= 0.0 && p.albedo <= 1.0))
-    throw Error("--albedo: must be in [0, 1], got " + num(p.albedo));
-  if (!(std::fabs(p.g) < 1.0)) throw Error("--g: |g| must be below 1, got " + num(p.g));
+    throw Error("--albedo: must be in [0, 1], got " + to_text(p.albedo));
+  if (!(std::fabs(p.g) < 1.0)) throw Error("--g: |g| must be below 1, got " + to_text(p.g));
   if (!(p.tau > 0.0) || std::isnan(p.tau))
-    throw Error("--tau: must be a positive optical thickness, got " + num(p.tau));
+    throw Error("--tau: must be a positive optical thickness, got " + to_text(p.tau));
   if (!(p.incidence_deg >= 0.0 && p.incidence_deg < 90.0))
-    throw Error("--incidence-deg: must be in [0, 90), got " + num(p.incidence_deg));
+    throw Error("--incidence-deg: must be in [0, 90), got " + to_text(p.incidence_deg));
   if (p.photons < 2 || p.photons > kMaxPhotonsPerRow)
-    throw Error("--photons: need 2 to 2^30 photons, got " + num(double(p.photons)));
+    throw Error("--photons: need 2 to 2^30 photons, got " + to_text(double(p.photons)));
 }
 
 SlabRun make_slab_run(const SlabParams& p) {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/cuda_check.h"
+#include "core/cuda_timer.h"
 #include "core/progress.h"
 #include "montecarlo/slab.h"
 #include "montecarlo/tabulate.h"
@@ -144,10 +145,7 @@ SphereTallies tabulate_sphere_cuda(const TabulateParams& p, Progress* progress) 
   // With a progress bar, launch ~20 slices of rows and report after each;
   // without one, a single launch (no tail between slices).
   const int rows_per_launch = progress ? std::max(1, (n_tau + 19) / 20) : n_tau;
-  cudaEvent_t start, stop;
-  NEBULA_CUDA_CHECK(cudaEventCreate(&start));
-  NEBULA_CUDA_CHECK(cudaEventCreate(&stop));
-  NEBULA_CUDA_CHECK(cudaEventRecord(start));
+  CudaEventTimer timer;
   for (int row_end = n_tau; row_end > 0; row_end -= rows_per_launch) {
     const int count = std::min(rows_per_launch, row_end);
     sphere_kernel<<<dim3(chunks, count), kThreads, shared>>>(rows.ptr, row_end, photons, n_mu,
@@ -158,16 +156,11 @@ SphereTallies tabulate_sphere_cuda(const TabulateParams& p, Progress* progress) 
       progress->add(uint64_t(count) * photons);
     }
   }
-  NEBULA_CUDA_CHECK(cudaEventRecord(stop));
-  NEBULA_CUDA_CHECK(cudaEventSynchronize(stop));
-  float ms = 0;
-  NEBULA_CUDA_CHECK(cudaEventElapsedTime(&ms, start, stop));
-  cudaEventDestroy(start);
-  cudaEventDestroy(stop);
+  const double transport_seconds = timer.seconds();
 
   SphereTallies t;
   t.resize(n_tau, n_mu);
-  t.compute_seconds = ms * 1e-3;
+  t.compute_seconds = transport_seconds;
   const std::vector<ull> w = sum_w.download(), w2 = sum_w2.download(), s = scalars.download();
   std::copy(w.begin(), w.end(), t.sum_w.begin());
   std::copy(w2.begin(), w2.end(), t.sum_w2.begin());

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/cuda_check.h"
+#include "core/cuda_timer.h"
 #include "raycast/renderer.h"
 #include "tables/device_table.h"
 
@@ -92,28 +93,20 @@ Image render_cuda(const RenderInputs& in, RenderStats* stats) {
   DeviceArray<float> pixels(image.pixels.size());
   DeviceArray<unsigned long long> clamps(1);
   const dim3 block(16, 16), grid((in.camera.width + 15) / 16, (in.camera.height + 15) / 16);
-  cudaEvent_t start, stop;
-  NEBULA_CUDA_CHECK(cudaEventCreate(&start));
-  NEBULA_CUDA_CHECK(cudaEventCreate(&stop));
-  NEBULA_CUDA_CHECK(cudaEventRecord(start));
+  CudaEventTimer timer;
   // One kernel per mode: the exact one carries none of the smooth mode's code.
   if (in.mode.step_voxels > 0.0f)
     render_kernel<true><<<grid, block>>>(scene, in.camera, in.mode, in.exposure, pixels.get(), clamps.get());
   else
     render_kernel<false><<<grid, block>>>(scene, in.camera, in.mode, in.exposure, pixels.get(), clamps.get());
   NEBULA_CUDA_CHECK(cudaGetLastError());
-  NEBULA_CUDA_CHECK(cudaEventRecord(stop));
-  NEBULA_CUDA_CHECK(cudaEventSynchronize(stop));
-  float ms = 0;
-  NEBULA_CUDA_CHECK(cudaEventElapsedTime(&ms, start, stop));
-  cudaEventDestroy(start);
-  cudaEventDestroy(stop);
+  const double march_seconds = timer.seconds();
   NEBULA_CUDA_CHECK(cudaMemcpy(image.pixels.data(), pixels.get(), image.pixels.size() * sizeof(float),
                                cudaMemcpyDeviceToHost));
   unsigned long long clamp_count = 0;
   NEBULA_CUDA_CHECK(cudaMemcpy(&clamp_count, clamps.get(), sizeof clamp_count, cudaMemcpyDeviceToHost));
   if (stats) {
-    stats->seconds = ms * 1e-3;
+    stats->seconds = march_seconds;
     stats->table_clamps = clamp_count;
   }
   return image;

@@ -26,12 +26,6 @@ std::mutex& fits_lock() {
   return m;
 }
 
-std::string num(double v) {
-  char text[40];
-  std::snprintf(text, sizeof text, "%.6g", v);
-  return text;
-}
-
 std::string bytes_text(double bytes) {
   const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
   int u = 0;
@@ -140,7 +134,7 @@ Hdf5Grid read_hdf5_grid(const std::string& path, const std::string& dataset) {
     const double voxel = read_numeric_attribute(voxel_holder, "voxel_size", 1, what)[0];
     if (!(voxel > 0) || !std::isfinite(voxel) || !(static_cast<float>(voxel) > 0) ||
         !std::isfinite(static_cast<float>(voxel)))
-      throw Error(what + ": attribute 'voxel_size' = " + num(voxel) +
+      throw Error(what + ": attribute 'voxel_size' = " + to_text(voxel) +
                   " must be positive and finite (the voxel edge in parsecs)");
     grid.shape.voxel = static_cast<float>(voxel);
     grid.has_voxel = true;
@@ -150,7 +144,7 @@ Hdf5Grid read_hdf5_grid(const std::string& path, const std::string& dataset) {
     const std::vector<double> o = read_numeric_attribute(origin_holder, "origin", 3, what);
     for (double v : o)
       if (!std::isfinite(v) || std::fabs(v) > 1e30)
-        throw Error(what + ": attribute 'origin' has a non-finite value " + num(v));
+        throw Error(what + ": attribute 'origin' has a non-finite value " + to_text(v));
     grid.shape.origin = Vec3{float(o[0]), float(o[1]), float(o[2])};
   }
   try {
@@ -183,7 +177,7 @@ bool fits_double_key(fitsfile* f, const std::string& key, double& value, const s
   }
   if (status != 0)
     throw Error(what + ": keyword " + key + " is not a number (" + fits_reason(status) + ")");
-  if (!std::isfinite(value)) throw Error(what + ": keyword " + key + " = " + num(value) + " is not finite");
+  if (!std::isfinite(value)) throw Error(what + ": keyword " + key + " = " + to_text(value) + " is not finite");
   return true;
 }
 
@@ -245,7 +239,7 @@ void check_grid_values(const std::string& what, const GridShape& shape,
                  z = i / (size_t(shape.nx) * size_t(shape.ny));
     throw Error(what + ": voxel (x=" + std::to_string(x) + ", y=" + std::to_string(y) +
                 ", z=" + std::to_string(z) + ") (index " + std::to_string(i) + ") is " +
-                num(v) + "; " + quantity + " must be finite and >= 0");
+                to_text(v) + "; " + quantity + " must be finite and >= 0");
   }
 }
 
@@ -273,8 +267,8 @@ std::vector<float> load_emission_hdf5(const std::string& path, const std::string
                 " x " + std::to_string(density_shape.nz));
   if (grid.has_voxel &&
       std::fabs(double(s.voxel) - density_shape.voxel) > 1e-6 * double(density_shape.voxel))
-    throw Error(what + ": voxel_size " + num(s.voxel) + " differs from the density's " +
-                num(density_shape.voxel));
+    throw Error(what + ": voxel_size " + to_text(s.voxel) + " differs from the density's " +
+                to_text(density_shape.voxel));
   check_grid_values(what, density_shape, grid.values, "emission");
   return std::move(grid.values);
 }
@@ -331,21 +325,21 @@ DensityGrid load_density_fits(const std::string& path, double voxel_size_pc) {
   if (found == 3) {
     for (int a = 1; a < 3; ++a)
       if (std::fabs(cdelt[a] - cdelt[0]) > 1e-6 * std::fabs(cdelt[0]))
-        throw Error(what + ": voxels must be cubes, but CDELT1 = " + num(cdelt[0]) + " and CDELT" +
-                    std::to_string(a + 1) + " = " + num(cdelt[a]));
+        throw Error(what + ": voxels must be cubes, but CDELT1 = " + to_text(cdelt[0]) + " and CDELT" +
+                    std::to_string(a + 1) + " = " + to_text(cdelt[a]));
     if (!(cdelt[0] > 0))
-      throw Error(what + ": CDELT1 = " + num(cdelt[0]) + " must be positive (flipped axes are not supported)");
+      throw Error(what + ": CDELT1 = " + to_text(cdelt[0]) + " must be positive (flipped axes are not supported)");
     voxel = cdelt[0];
     if (voxel_size_pc > 0 && std::fabs(voxel_size_pc - voxel) > 1e-6 * voxel)
-      throw Error(what + ": the scene's voxel size " + num(voxel_size_pc) +
-                  " pc disagrees with the file's CDELT1 = " + num(voxel) + " pc");
+      throw Error(what + ": the scene's voxel size " + to_text(voxel_size_pc) +
+                  " pc disagrees with the file's CDELT1 = " + to_text(voxel) + " pc");
   } else {
     if (!(voxel_size_pc > 0) || !std::isfinite(voxel_size_pc))
       throw Error(what + ": no CDELT1/2/3 keywords and no voxel size given (voxel_size_pc)");
     voxel = voxel_size_pc;
   }
   if (!(static_cast<float>(voxel) > 0) || !std::isfinite(static_cast<float>(voxel)))
-    throw Error(what + ": voxel size " + num(voxel) + " pc is not representable");
+    throw Error(what + ": voxel size " + to_text(voxel) + " pc is not representable");
   grid.shape.voxel = static_cast<float>(voxel);
 
   double crpix[3], crval[3];

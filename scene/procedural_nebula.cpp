@@ -15,17 +15,11 @@
 namespace nebula {
 namespace {
 
-std::string num(double v) {
-  char text[40];
-  std::snprintf(text, sizeof text, "%.6g", v);
-  return text;
-}
-
 bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 std::string vec_text(Vec3 v) {
   std::string text = "[";
-  text += num(v.x) + ", " + num(v.y) + ", " + num(v.z) + "]";
+  text += to_text(v.x) + ", " + to_text(v.y) + ", " + to_text(v.z) + "]";
   return text;
 }
 
@@ -40,8 +34,8 @@ struct Checker {
     const bool ok =
         std::isfinite(v) && (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
     if (!ok)
-      refuse(name, num(v),
-             std::string("must be in ") + (lo_open ? "(" : "[") + num(lo) + ", " + num(hi) +
+      refuse(name, to_text(v),
+             std::string("must be in ") + (lo_open ? "(" : "[") + to_text(lo) + ", " + to_text(hi) +
                  (hi_open ? ")" : "]"));
   }
   void direction(const char* name, Vec3 v) {
@@ -160,8 +154,8 @@ std::optional<ParameterIssue> check_procedural(const ProceduralParams& p) {
   c.range("bubble_radius", p.bubble_radius, 0, 2, true, false);
   c.range("bubble_offset", p.bubble_offset, 0, 2, false, false);
   if (!(p.bubble_offset < p.bubble_radius))
-    c.refuse("bubble_offset", num(p.bubble_offset),
-             "must be less than bubble_radius = " + num(p.bubble_radius) +
+    c.refuse("bubble_offset", to_text(p.bubble_offset),
+             "must be less than bubble_radius = " + to_text(p.bubble_radius) +
                  " (the star lies inside its bubble)");
   c.range("bubble_tau", p.bubble_tau, 0, 1e30, false, false);
   c.range("shell_thickness", p.shell_thickness, 0, 2, true, false);
@@ -180,8 +174,8 @@ std::optional<ParameterIssue> check_procedural(const ProceduralParams& p) {
     const double top = p.noise_frequency * std::pow(p.noise_lacunarity, p.noise_octaves - 1);
     if (!(top <= kMaxNoiseFrequency))
       c.refuse("noise_octaves", std::to_string(p.noise_octaves),
-               "the highest octave would have " + num(top) + " cycles per edge, more than " +
-                   num(kMaxNoiseFrequency));
+               "the highest octave would have " + to_text(top) + " cycles per edge, more than " +
+                   to_text(kMaxNoiseFrequency));
   }
   return c.issue;
 }

@@ -27,7 +27,7 @@ bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::is
 
 std::string vec_text(Vec3 v) {
   std::string text = "[";
-  text += number_text(v.x) + ", " + number_text(v.y) + ", " + number_text(v.z) + "]";
+  text += to_text(v.x) + ", " + to_text(v.y) + ", " + to_text(v.z) + "]";
   return text;
 }
 
@@ -49,7 +49,7 @@ std::optional<SceneIssue> per_band_issue(const Scene& s, const std::vector<doubl
   for (size_t b = 0; b < values.size(); ++b)
     if (!(std::isfinite(values[b]) && good(values[b])))
       return SceneIssue{all_equal(values) ? "dust." + name : "dust." + name + "." + s.bands[b],
-                        "is " + number_text(values[b]) + "; must be " + range};
+                        "is " + to_text(values[b]) + "; must be " + range};
   return std::nullopt;
 }
 
@@ -75,14 +75,14 @@ std::optional<SceneIssue> camera_issue(const CameraSpec& c) {
                                        ", parallel to the view direction (look_at - position); "
                                        "choose an up vector across it"};
   if (!(std::isfinite(c.fov_deg) && c.fov_deg > 0 && c.fov_deg < 180))
-    return SceneIssue{"camera.fov_deg", "is " + number_text(c.fov_deg) + "; must be in (0, 180)"};
+    return SceneIssue{"camera.fov_deg", "is " + to_text(c.fov_deg) + "; must be in (0, 180)"};
   if (c.kind == CameraKind::Orthographic) {
     if (!(std::isfinite(c.ortho_width) && c.ortho_width > 0))
-      return SceneIssue{"camera.ortho_width", "is " + number_text(c.ortho_width) +
+      return SceneIssue{"camera.ortho_width", "is " + to_text(c.ortho_width) +
                                                   "; an orthographic camera needs a width "
                                                   "(parsecs across the image) > 0"};
   } else if (!(std::isfinite(c.ortho_width) && c.ortho_width >= 0)) {
-    return SceneIssue{"camera.ortho_width", "is " + number_text(c.ortho_width) + "; must be >= 0"};
+    return SceneIssue{"camera.ortho_width", "is " + to_text(c.ortho_width) + "; must be >= 0"};
   }
   if (c.width < 1) return SceneIssue{"camera.width", "is " + std::to_string(c.width) + "; must be >= 1"};
   if (c.height < 1) return SceneIssue{"camera.height", "is " + std::to_string(c.height) + "; must be >= 1"};
@@ -96,7 +96,7 @@ std::optional<SceneIssue> camera_issue(const CameraSpec& c) {
                                            std::to_string(c.width) +
                                            "; a fisheye dome master must be square"};
   if (!(std::isfinite(c.exposure) && c.exposure > 0))
-    return SceneIssue{"camera.exposure", "is " + number_text(c.exposure) + "; must be > 0"};
+    return SceneIssue{"camera.exposure", "is " + to_text(c.exposure) + "; must be > 0"};
   return std::nullopt;
 }
 
@@ -104,10 +104,10 @@ std::optional<SceneIssue> star_issue(const SceneStar& star, const std::string& k
   if (!finite(star.position)) return SceneIssue{key + ".position", "must be finite"};
   if (!(std::isfinite(star.luminosity_lsun) && star.luminosity_lsun > 0))
     return SceneIssue{key + ".luminosity_lsun",
-                      "is " + number_text(star.luminosity_lsun) + "; must be > 0 (L_sun)"};
+                      "is " + to_text(star.luminosity_lsun) + "; must be > 0 (L_sun)"};
   if (!(std::isfinite(star.temperature_K) && star.temperature_K > 0))
     return SceneIssue{key + ".temperature_K",
-                      "is " + number_text(star.temperature_K) + "; must be > 0 (K)"};
+                      "is " + to_text(star.temperature_K) + "; must be > 0 (K)"};
   if (!star.spectral_class.empty()) {
     double t = 0;
     try {
@@ -117,20 +117,14 @@ std::optional<SceneIssue> star_issue(const SceneStar& star, const std::string& k
     }
     if (std::fabs(t - star.temperature_K) > kClassTemperatureTolerance)
       return SceneIssue{key + ".temperature_K",
-                        "is " + number_text(star.temperature_K) + " K but class '" +
-                            star.spectral_class + "' has " + number_text(t) +
+                        "is " + to_text(star.temperature_K) + " K but class '" +
+                            star.spectral_class + "' has " + to_text(t) +
                             " K (Pecaut & Mamajek 2013); give one of them, or both agreeing"};
   }
   return std::nullopt;
 }
 
 }  // namespace
-
-std::string number_text(double v) {
-  char text[40];
-  std::snprintf(text, sizeof text, "%.6g", v);
-  return text;
-}
 
 bool known_band(const std::string& band) { return band == "B" || band == "V" || band == "R"; }
 
@@ -149,8 +143,8 @@ std::optional<SceneIssue> settings_issue(const Scene& s) {
                                   [](double g) { return std::fabs(g) < 1; }))
     return issue;
   if (!(std::isfinite(s.dust.R_V) && s.dust.R_V >= kMinRV && s.dust.R_V <= kMaxRV))
-    return SceneIssue{"dust.R_V", "is " + number_text(s.dust.R_V) + "; must be in [" +
-                                      number_text(kMinRV) + ", " + number_text(kMaxRV) +
+    return SceneIssue{"dust.R_V", "is " + to_text(s.dust.R_V) + "; must be in [" +
+                                      to_text(kMinRV) + ", " + to_text(kMaxRV) +
                                       "], where the extinction law holds"};
   if (!s.dust.table_files.empty() && s.dust.table_files.size() != s.bands.size())
     return SceneIssue{"dust.tables", "has " + std::to_string(s.dust.table_files.size()) +
@@ -162,7 +156,7 @@ std::optional<SceneIssue> settings_issue(const Scene& s) {
   if (s.output.empty()) return SceneIssue{"output.file", "must not be empty"};
   if (!(std::isfinite(s.star_psf_pixels) && s.star_psf_pixels > 0 && s.star_psf_pixels <= 1000))
     return SceneIssue{"output.star_psf_pixels",
-                      "is " + number_text(s.star_psf_pixels) + "; must be in (0, 1000]"};
+                      "is " + to_text(s.star_psf_pixels) + "; must be in (0, 1000]"};
   return std::nullopt;
 }
 
@@ -172,7 +166,7 @@ std::optional<SceneIssue> grids_issue(const Scene& s) {
     return SceneIssue{"density", "the grid has a zero size (" + std::to_string(g.nx) + " x " +
                                      std::to_string(g.ny) + " x " + std::to_string(g.nz) + ")"};
   if (!(std::isfinite(g.voxel) && g.voxel > 0))
-    return SceneIssue{"density", "voxel size " + number_text(g.voxel) + " must be > 0"};
+    return SceneIssue{"density", "voxel size " + to_text(g.voxel) + " must be > 0"};
   if (!finite(g.origin)) return SceneIssue{"density", "the grid origin must be finite"};
   try {
     check_grid_values("tau_v", g, s.density.tau_v);

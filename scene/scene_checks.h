@@ -5,6 +5,8 @@
 #include <optional>
 #include <string>
 
+#include "core/error.h"
+
 #include "scene/scene.h"
 
 namespace nebula::scene_detail {
@@ -26,6 +28,6 @@ std::optional<SceneIssue> grids_issue(const Scene& scene);
 // "B", "V" or "R": the bands with passbands and extinction ratios.
 bool known_band(const std::string& band);
 
-std::string number_text(double v);
+inline std::string number_text(double v) { return to_text(v); }
 
 }  // namespace nebula::scene_detail
