@@ -11,17 +11,13 @@
 #include "core/error.h"
 #include "core/philox.h"
 #include "scene/density_sources.h"
+#include "scene/scene_checks.h"
 
 namespace nebula {
 namespace {
 
-bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-
-std::string vec_text(Vec3 v) {
-  std::string text = "[";
-  text += to_text(v.x) + ", " + to_text(v.y) + ", " + to_text(v.z) + "]";
-  return text;
-}
+using scene_detail::finite;
+using scene_detail::vec_text;
 
 // Collects the first issue; later checks are skipped once one is found.
 struct Checker {

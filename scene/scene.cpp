@@ -23,14 +23,6 @@ const char* to_string(CameraKind kind) {
 namespace scene_detail {
 namespace {
 
-bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-
-std::string vec_text(Vec3 v) {
-  std::string text = "[";
-  text += to_text(v.x) + ", " + to_text(v.y) + ", " + to_text(v.z) + "]";
-  return text;
-}
-
 bool all_equal(const std::vector<double>& v) {
   for (double x : v)
     if (!(x == v.front())) return false;

@@ -2,6 +2,7 @@
 // Internal to scene/: the range checks shared by validate_scene and
 // load_scene. Each returns the first problem with its key named as in the
 // scene file (docs/scene.md), or nothing.
+#include <cmath>
 #include <optional>
 #include <string>
 
@@ -29,5 +30,12 @@ std::optional<SceneIssue> grids_issue(const Scene& scene);
 bool known_band(const std::string& band);
 
 inline std::string number_text(double v) { return to_text(v); }
+
+inline bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// "[x, y, z]" as messages print a position or direction.
+inline std::string vec_text(Vec3 v) {
+  return "[" + to_text(v.x) + ", " + to_text(v.y) + ", " + to_text(v.z) + "]";
+}
 
 }  // namespace nebula::scene_detail
