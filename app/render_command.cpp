@@ -11,6 +11,7 @@
 
 #include "app/commands.h"
 #include "app/output_path.h"
+#include "app/scene_setup.h"
 #include "app/table_cache.h"
 #include "core/error.h"
 #include "core/progress.h"
@@ -30,32 +31,6 @@ namespace {
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
-Camera camera_of(const CameraSpec& c) {
-  CameraSettings s;
-  s.projection = c.kind == CameraKind::Perspective    ? Projection::Perspective
-                 : c.kind == CameraKind::Orthographic ? Projection::Orthographic
-                                                      : Projection::Fisheye;
-  s.position = c.position;
-  s.look_at = c.look_at;
-  s.up = c.up;
-  s.fov_deg = c.fov_deg;
-  s.ortho_width = c.ortho_width;
-  s.width = c.width;
-  s.height = c.height;
-  return make_camera(s);
-}
-
-// Refuses an image format before any work: by extension, and .exr/.png when
-// this build has no OpenImageIO.
-void check_image_extension(const std::string& out) {
-  const auto dot = out.rfind('.');
-  const std::string ext = dot == std::string::npos ? "" : out.substr(dot);
-  if (ext != ".h5" && ext != ".fits" && ext != ".fit" && ext != ".exr" && ext != ".png")
-    throw Error("-o: " + out + ": unknown image format; use .exr, .fits, .png or .h5");
-  if ((ext == ".exr" || ext == ".png") && !openimageio_available())
-    throw Error("-o: " + out + ": " + ext + " needs OpenImageIO, which this build lacks; use .h5 or .fits");
 }
 
 struct Options {
@@ -78,7 +53,7 @@ void run_render(const Options& o) {
   validate_scene(scene);
   const std::string out = o.out.empty() ? scene.output : o.out;
   check_output_path("-o", out, o.force);
-  check_image_extension(out);
+  check_image_extension("-o", out);
   if (!(o.smooth == 0 || o.smooth >= 1e-3f)) throw Error("--smooth: step in voxels, at least 1e-3 (0: exact)");
   const Backend backend = parse_backend(o.backend);
   const uint64_t photons = parse_count("--table-photons", o.table_photons, 1000, double(kMaxPhotonsPerRow));
@@ -86,14 +61,10 @@ void run_render(const Options& o) {
   const size_t n_bands = scene.bands.size();
   std::vector<std::string> computed;
 
-  // Bands: the extinction law averaged over each passband, normalised to V.
-  const std::string data = default_data_dir();
-  std::vector<Passband> passbands;
-  for (const std::string& b : scene.bands) passbands.push_back(load_bessell(data, b.at(0)));
-  std::vector<float> ratios(n_bands);
-  for (size_t b = 0; b < n_bands; ++b)
-    ratios[b] = static_cast<float>(band_extinction_ratio(passbands[b], scene.dust.R_V, scene.dust.law) /
-                                   band_extinction_ratio(load_bessell(data, 'V'), scene.dust.R_V, scene.dust.law));
+  // Bands: the extinction law averaged over each passband, normalised to V;
+  // star powers per band from black-body fractions.
+  const SceneBands sb = scene_bands(scene);
+  const std::vector<float>& ratios = sb.extinction_ratio;
 
   // Tables: one per distinct (albedo, g) among scattering bands, nothing for a = 0.
   std::map<std::pair<double, double>, std::shared_ptr<ScatteringTable>> tables;
@@ -125,15 +96,10 @@ void run_render(const Options& o) {
     band_table[b] = tables[key].get();
   }
 
-  // Stars: band powers from black-body fractions; one V-band depth bake each.
-  std::vector<std::vector<float>> power(scene.stars.size(), std::vector<float>(n_bands));
+  // Stars: one V-band depth bake each.
+  const std::vector<std::vector<float>>& power = sb.star_power;
   std::vector<Vec3> positions;
-  for (size_t k = 0; k < scene.stars.size(); ++k) {
-    for (size_t b = 0; b < n_bands; ++b)
-      power[k][b] = static_cast<float>(scene.stars[k].luminosity_lsun *
-                                       band_fraction(scene.stars[k].temperature_K, passbands[b]));
-    positions.push_back(scene.stars[k].position);
-  }
+  for (const SceneStar& star : scene.stars) positions.push_back(star.position);
   bool scatters = false;
   for (size_t b = 0; b < n_bands; ++b) scatters = scatters || band_table[b] != nullptr;
   BakeResult bake;
