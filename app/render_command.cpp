@@ -21,7 +21,9 @@
 #include "illumination/passband.h"
 #include "illumination/star.h"
 #include "imageio/image_output.h"
+#include "multires/volume_pyramid.h"
 #include "raycast/point_stars.h"
+#include "raycast/pyramid_render.h"
 #include "raycast/renderer.h"
 #include "scene/scene_file.h"
 #include "tables/table_file.h"
@@ -37,7 +39,7 @@ struct Options {
   std::string scene_path, out, backend = "auto", table_photons = "3e4";
   std::vector<std::string> overrides;
   bool demo = false, force = false, quiet = false;
-  int width = 0, height = 0;
+  int width = 0, height = 0, levels = -1;
   float smooth = 0;
 };
 
@@ -50,7 +52,15 @@ void run_render(const Options& o) {
   if (o.width > 0) scene.camera.width = o.width;
   if (o.height > 0) scene.camera.height = o.height;
   if (o.width < 0 || o.height < 0) throw Error("--width/--height: must be positive");
+  if (o.levels < -1) throw Error("--levels: must be 0 or more");
+  if (o.levels >= 0) scene.pyramid_levels = o.levels;
   validate_scene(scene);
+  const int most_levels = max_pyramid_levels(scene.density.shape);
+  if (scene.pyramid_levels > most_levels)
+    throw Error(std::string(o.levels >= 0 ? "--levels" : scene.path + ": render.levels") + ": " +
+                std::to_string(scene.pyramid_levels) + " exceeds the " + std::to_string(most_levels) +
+                " a grid of " + std::to_string(scene.density.shape.nx) + "x" + std::to_string(scene.density.shape.ny) +
+                "x" + std::to_string(scene.density.shape.nz) + " allows (the coarsest level keeps 2 voxels)");
   const std::string out = o.out.empty() ? scene.output : o.out;
   check_output_path("-o", out, o.force);
   check_image_extension("-o", out);
@@ -132,8 +142,13 @@ void run_render(const Options& o) {
   if (!o.quiet && backend == Backend::Cpu)
     render_progress = std::make_unique<Progress>("render", uint64_t(camera.height));
   in.progress = render_progress.get();
-  Image image = render(in, backend, &stats);
+  const PyramidResult pyramid = render_pyramid(in, scene.pyramid_levels, backend);
   if (render_progress) render_progress->finish();
+  Image image = pyramid.image;
+  for (const PyramidLevelReport& r : pyramid.report) {
+    stats.seconds += r.render_seconds;
+    stats.table_clamps += r.table_clamps;
+  }
   if (scene.draw_stars) {
     std::vector<PointStar> points;
     for (size_t k = 0; k < positions.size(); ++k) points.push_back(PointStar{positions[k], power[k]});
@@ -154,6 +169,7 @@ void run_render(const Options& o) {
                                         "x" + std::to_string(camera.height)});
   meta.entries.push_back({"scene", scene.path});
   meta.entries.push_back({"mode", o.smooth > 0 ? "smooth step " + to_text(o.smooth) + " voxel" : "exact"});
+  meta.entries.push_back({"pyramid_levels", std::to_string(scene.pyramid_levels)});
   write_image(image, out, meta, o.force);
 
   std::printf("rendered %s: %dx%d %s, %zu band(s), %zu star(s), grid %dx%dx%d, %s traversal, %s\n",
@@ -167,7 +183,14 @@ void run_render(const Options& o) {
                 band_table[b] ? "" : " (no scattering: no table)");
   for (const std::string& c : computed) std::printf("  %s\n", c.c_str());
   std::printf("  emission: %s\n", scene.emission.empty() ? "none in the scene" : "per band grid");
-  std::printf("  pyramid levels: none (not yet implemented)\n");
+  if (pyramid.report.size() == 1) std::printf("  pyramid levels: none\n");
+  for (size_t j = 1; j < pyramid.report.size(); ++j) {
+    const PyramidLevelReport& r = pyramid.report[j];
+    std::printf("  pyramid level %d: grid %dx%dx%d (voxel %g pc), image %dx%d; build %.3f s, bake %.3f s, render %.3f s, "
+                "%llu lookups beyond tau_max\n",
+                r.level, r.shape.nx, r.shape.ny, r.shape.nz, r.shape.voxel, r.width, r.height, r.pyramid_seconds,
+                r.bake_seconds, r.render_seconds, (unsigned long long)r.table_clamps);
+  }
   std::printf("render: %.3f s marching, %llu table lookups beyond tau_max (clamped); total %.2f s\n", stats.seconds,
               (unsigned long long)stats.table_clamps, seconds_since(start));
   std::printf("wrote %s\n", out.c_str());
@@ -187,6 +210,8 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--set", o->overrides, "KEY=VALUE scene override, e.g. camera.fov_deg=30 (repeatable)");
   cmd->add_option("--smooth", o->smooth, "smooth display mode: trilinear fields at this step in voxels (0: exact)")
       ->capture_default_str();
+  cmd->add_option("--levels", o->levels,
+                  "coarser pyramid levels for wide-range multiple scattering (default: the scene's render.levels, 0)");
   cmd->add_option("--table-photons", o->table_photons, "photons per row for tables generated on first use")
       ->capture_default_str();
   cmd->add_flag("--force", o->force, "overwrite an existing output");

@@ -21,8 +21,8 @@ Camera make_camera(const CameraSettings& s) {
   Camera c;
   c.projection = s.projection;
   c.position = s.position;
-  c.width = s.width;
-  c.height = s.height;
+  c.width = c.frame_width = s.width;
+  c.height = c.frame_height = s.height;
   c.forward = normalize(view);
   const Vec3 side = cross(c.forward, s.up);
   if (!(length(side) > 1e-6f * length(s.up)))
@@ -40,6 +40,14 @@ Camera make_camera(const CameraSettings& s) {
     throw Error("camera: a fisheye dome master must be square (width == height)");
   }
   return c;
+}
+
+Camera coarser_camera(const Camera& c) {
+  Camera out = c;
+  out.width = (c.width + 1) / 2;
+  out.height = (c.height + 1) / 2;
+  out.pixel_span = 2 * c.pixel_span;
+  return out;
 }
 
 }  // namespace nebula

@@ -20,14 +20,19 @@ struct Camera {
   float tan_half_fov = 0;   // perspective: vertical half-angle
   float half_width = 0;     // orthographic: half extent in world units
   float half_height = 0;
+  // The frame the image covers, in pixels of the full-resolution image; a
+  // coarser pyramid level (multires/) renders the same frame with pixels
+  // pixel_span times larger (image width ceil(frame_width / pixel_span)).
+  int frame_width = 0, frame_height = 0;
+  float pixel_span = 1;
 
   // The ray through the centre of pixel (px, py); false where the pixel shows
   // nothing (outside the dome circle of the fisheye).
   NEBULA_HD bool ray(int px, int py, Vec3& origin, Vec3& dir) const {
-    const float u = 2.0f * (px + 0.5f) / width - 1.0f;   // -1 left .. 1 right
-    const float v = 1.0f - 2.0f * (py + 0.5f) / height;  // 1 top .. -1 bottom
+    const float u = 2.0f * (px + 0.5f) * pixel_span / frame_width - 1.0f;   // -1 left .. 1 right
+    const float v = 1.0f - 2.0f * (py + 0.5f) * pixel_span / frame_height;  // 1 top .. -1 bottom
     if (projection == Projection::Perspective) {
-      const float aspect = float(width) / float(height);
+      const float aspect = float(frame_width) / float(frame_height);
       origin = position;
       dir = normalize(forward + (u * aspect * tan_half_fov) * right + (v * tan_half_fov) * up);
       return true;
@@ -60,6 +65,10 @@ struct CameraSettings {
 
 // Builds the camera; throws Error naming the setting when it is degenerate.
 Camera make_camera(const CameraSettings& s);
+
+// The same frame at half the resolution (ceil of each size): pixel i covers
+// pixels 2i and 2i + 1 of `c` (the pyramid's image levels).
+Camera coarser_camera(const Camera& c);
 
 const char* to_string(Projection p);
 

@@ -49,6 +49,35 @@ TEST(Camera, OrthographicRaysAreParallel) {
   EXPECT_NEAR(o.y, 1.0f - 0.05f, 1e-5f);
 }
 
+TEST(Camera, ACoarserCameraSeesTheSameFrameWithBiggerPixels) {
+  CameraSettings s;
+  s.projection = Projection::Orthographic;
+  s.position = {0, 0, -10};
+  s.look_at = {0, 0, 0};
+  s.ortho_width = 4;
+  s.width = 41;  // odd: the last coarse pixel reaches one fine pixel past the frame
+  s.height = 20;
+  const Camera fine = make_camera(s);
+  const Camera coarse = coarser_camera(coarser_camera(fine));
+  EXPECT_EQ(coarse.width, 11);
+  EXPECT_EQ(coarse.height, 5);
+  Vec3 o, d, o0, o1, o2, o3, unused;
+  // A level-2 pixel's centre is the mean of the 4 x 4 fine pixel centres it spans.
+  coarse.ray(3, 2, o, d);
+  fine.ray(12, 8, o0, unused);
+  fine.ray(15, 11, o1, unused);
+  EXPECT_NEAR(o.x, 0.5f * (o0.x + o1.x), 1e-5f);
+  EXPECT_NEAR(o.y, 0.5f * (o0.y + o1.y), 1e-5f);
+  // Perspective: the same field of view, so the centre pixel still looks ahead.
+  s.projection = Projection::Perspective;
+  s.width = 40;
+  const Camera p = coarser_camera(make_camera(s));
+  p.ray(9, 4, o2, d);
+  p.ray(10, 5, o3, unused);
+  EXPECT_NEAR((d + unused).x, 0.0f, 1e-6f);
+  EXPECT_NEAR((d + unused).y, 0.0f, 1e-6f);
+}
+
 TEST(Camera, FisheyeIsAzimuthalEquidistant) {
   CameraSettings s;
   s.projection = Projection::Fisheye;

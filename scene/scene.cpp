@@ -149,6 +149,8 @@ std::optional<SceneIssue> settings_issue(const Scene& s) {
   if (!(std::isfinite(s.star_psf_pixels) && s.star_psf_pixels > 0 && s.star_psf_pixels <= 1000))
     return SceneIssue{"output.star_psf_pixels",
                       "is " + to_text(s.star_psf_pixels) + "; must be in (0, 1000]"};
+  if (s.pyramid_levels < 0 || s.pyramid_levels > 16)
+    return SceneIssue{"render.levels", "is " + std::to_string(s.pyramid_levels) + "; must be in 0..16"};
   return std::nullopt;
 }
 

@@ -63,6 +63,10 @@ struct Scene {
   std::string output = "nebula.exr";  // as written; relative to the working directory
   bool draw_stars = false;
   double star_psf_pixels = 1.5;  // Gaussian sigma of a drawn star, pixels
+  // Coarser levels of the multi-resolution pyramid added to the render (2005
+  // paper, section 4.2); 0: the plain render. At most the grid allows
+  // (multires/volume_pyramid.h), checked by the renderer.
+  int pyramid_levels = 0;
 };
 
 // Checks a Scene built in code (load_scene checks the same rules and more):

@@ -58,7 +58,8 @@ const char* type_name(const toml::node& n) {
 
 // The keys of every table in a scene file.
 const std::initializer_list<std::string_view> kTopKeys = {"bands",  "density", "emission", "dust",
-                                                          "stars",  "camera",  "output"};
+                                                          "stars",  "camera",  "output", "render"};
+const std::initializer_list<std::string_view> kRenderKeys = {"levels"};
 const std::initializer_list<std::string_view> kDensityKeys = {
     "file", "dataset", "fits", "voxel_size_pc", "procedural", "scale"};
 const std::initializer_list<std::string_view> kProceduralKeys = {
@@ -225,6 +226,7 @@ class Parser {
   std::vector<SceneStar> parse_stars(const toml::table& root, const DensityPlan& density) const;
   CameraSpec parse_camera(const toml::table& root) const;
   void parse_output(const toml::table& root, Scene& scene) const;
+  void parse_render(const toml::table& root, Scene& scene) const;
   void load_grids(const DensityPlan& density, const std::optional<EmissionPlan>& emission,
                   Scene& scene) const;
 
@@ -561,6 +563,14 @@ void Parser::parse_output(const toml::table& root, Scene& scene) const {
     scene.star_psf_pixels = number(*v, "output.star_psf_pixels");
 }
 
+void Parser::parse_render(const toml::table& root, Scene& scene) const {
+  const toml::node* n = root.get("render");
+  if (n == nullptr) return;
+  const toml::table& t = table_at(*n, "render");
+  known_keys(t, "render", kRenderKeys);
+  if (const toml::node* v = t.get("levels")) scene.pyramid_levels = small_integer(*v, "render.levels");
+}
+
 void Parser::load_grids(const DensityPlan& density, const std::optional<EmissionPlan>& emission,
                         Scene& scene) const {
   try {
@@ -608,6 +618,7 @@ Scene Parser::build(toml::table& root) {
     fail("stars", "missing: a scene needs at least one [[stars]] entry (or an [emission] grid)");
   scene.camera = parse_camera(root);
   parse_output(root, scene);
+  parse_render(root, scene);
   if (const auto issue = scene_detail::settings_issue(scene)) fail(issue->key, issue->reason);
   load_grids(density, emission, scene);  // the expensive part, last
   if (const auto issue = scene_detail::grids_issue(scene)) fail(issue->key, issue->reason);

@@ -532,3 +532,21 @@ TEST(Scene, ValidateSceneNamesTheKey) {
 
 }  // namespace
 }  // namespace nebula
+
+namespace nebula {
+namespace {
+
+TEST_F(SceneFile, RenderLevelsIsReadAndChecked) {
+  const Scene none = load_scene(write_text("plain.toml", kBase));
+  EXPECT_EQ(none.pyramid_levels, 0);
+  const Scene three = load_scene(write_text("levels.toml", std::string(kBase) + "[render]\nlevels = 3\n"));
+  EXPECT_EQ(three.pyramid_levels, 3);
+  const Scene set = load_scene(write_text("set.toml", kBase), {"render.levels=2"});
+  EXPECT_EQ(set.pyramid_levels, 2);
+  refused("negative", std::string(kBase) + "[render]\nlevels = -1\n", {"render.levels", "0..16"});
+  refused("float", std::string(kBase) + "[render]\nlevels = 1.5\n", {"render.levels", "integer"});
+  refused("unknown", std::string(kBase) + "[render]\nstep = 1\n", {"render.step"});
+}
+
+}  // namespace
+}  // namespace nebula

@@ -1,0 +1,39 @@
+#pragma once
+// Wide-range multiple scattering with the resolution pyramid of the 2005
+// paper (section 4.2; DESIGN.md section 3): volume level j (multires/) lit by
+// its own bake and rendered at 1/2^j of the resolution; the clipped
+// difference images are up-sampled and added to the level-0 image.
+#include <cstdint>
+#include <vector>
+
+#include "core/backend.h"
+#include "core/grid.h"
+#include "core/image.h"
+#include "raycast/renderer.h"
+
+namespace nebula {
+
+struct PyramidLevelReport {
+  int level = 0;
+  GridShape shape;
+  int width = 0, height = 0;
+  double bake_seconds = 0;    // this level's star bake (0 for level 0: baked by the caller)
+  double pyramid_seconds = 0; // building this level's volume and emission from the level below
+  double render_seconds = 0;  // marching (CUDA events on the GPU)
+  uint64_t table_clamps = 0;  // lookups beyond the table's tau range (coarse voxels are thicker)
+};
+
+struct PyramidResult {
+  Image image;                      // I_0 + the up-sampled clipped differences
+  std::vector<Image> levels;        // I_0 .. I_n (I_j at 1/2^j resolution)
+  std::vector<Image> differences;   // dI_1 .. dI_n at their levels' sizes (index 0 empty)
+  std::vector<PyramidLevelReport> report;  // one per level, 0 first
+  double combine_seconds = 0;
+};
+
+// `in` is the level-0 render (its stars' depths baked by the caller); levels
+// 0 gives exactly render(in, backend). Throws Error for levels outside
+// 0..max_pyramid_levels(in.density->shape).
+PyramidResult render_pyramid(const RenderInputs& in, int levels, Backend backend);
+
+}  // namespace nebula
