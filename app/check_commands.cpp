@@ -222,6 +222,40 @@ void add_bench_command(CLI::App& app) {
       std::fflush(stdout);
     }
   });
+
+  auto* pyr = cmd->add_subcommand("pyramid", "the cost of each pyramid level on the procedural nebula, one star");
+  struct PyramidOptions {
+    std::string backend = "auto";
+    int size = 256, width = 1920, height = 1080, levels = 3, repeats = 5;
+  };
+  auto p = std::make_shared<PyramidOptions>();
+  pyr->add_option("--backend", p->backend, "cpu, cuda or auto")->capture_default_str();
+  pyr->add_option("--size", p->size, "voxels per grid edge")->capture_default_str();
+  pyr->add_option("--width", p->width, "image width")->capture_default_str();
+  pyr->add_option("--height", p->height, "image height")->capture_default_str();
+  pyr->add_option("--levels", p->levels, "coarser levels")->capture_default_str();
+  pyr->add_option("--repeats", p->repeats, "timed frames after the warm-up")->capture_default_str();
+  pyr->callback([p] {
+    if (p->size < 4 || p->size > 1024) throw Error("--size: must be 4 to 1024");
+    if (p->width < 1 || p->height < 1) throw Error("--width/--height: must be positive");
+    if (p->repeats < 1) throw Error("--repeats: must be at least 1");
+    const Backend backend = parse_backend(p->backend);
+    const PyramidBench b = bench_pyramid(backend, p->size, p->width, p->height, p->levels, p->repeats);
+    std::printf("pyramid on %s, procedural nebula %d^3, 1 star, level-0 bake %.2f ms\n", b.backend.c_str(), b.size,
+                1e3 * b.bake_seconds);
+    std::printf("| level | grid | image | build ms | bake ms | render ms (median of %d) | frame ms with levels 0..j |\n"
+                "|---|---|---|---|---|---|---|\n",
+                p->repeats);
+    double frame = 0;
+    for (const PyramidLevelReport& r : b.levels) {
+      frame += r.render_seconds;
+      std::printf("| %d | %dx%dx%d | %dx%d | %.2f | %.2f | %.3f | %.3f |\n", r.level, r.shape.nx, r.shape.ny,
+                  r.shape.nz, r.width, r.height, 1e3 * r.pyramid_seconds, 1e3 * r.bake_seconds,
+                  1e3 * r.render_seconds, 1e3 * (frame + (r.level > 0 ? b.combine_seconds : 0)));
+    }
+    std::printf("combination on the host (down, clipped difference, up, add): %.3f ms per frame\n",
+                1e3 * b.combine_seconds);
+  });
 }
 
 }  // namespace nebula::app

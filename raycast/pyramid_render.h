@@ -31,9 +31,28 @@ struct PyramidResult {
   double combine_seconds = 0;
 };
 
-// `in` is the level-0 render (its stars' depths baked by the caller); levels
-// 0 gives exactly render(in, backend). Throws Error for levels outside
-// 0..max_pyramid_levels(in.density->shape).
+// The coarser levels' volumes, emission and star bakes: what a camera move
+// leaves unchanged (built once, rendered every frame).
+struct PyramidLevelData {
+  DensityGrid density;
+  std::vector<std::vector<float>> emission;  // per band; empty where the band has none
+  std::vector<std::vector<float>> depth;     // per star, baked V-band depth
+  PyramidLevelReport report;                 // build and bake times filled in
+};
+struct PreparedPyramid {
+  std::vector<PyramidLevelData> levels;  // levels 1..n (level 0 is the caller's)
+};
+
+// `in` is the level-0 render (its stars' depths baked by the caller). Throws
+// Error for levels outside 0..max_pyramid_levels(in.density->shape).
+PreparedPyramid prepare_pyramid(const RenderInputs& in, int levels, Backend backend);
+
+// One frame: level 0 from `in`, the coarser levels from `prepared` (built for
+// the same grid, bands and stars), each at 1/2^j of in.camera's resolution.
+// No levels gives exactly render(in, backend).
+PyramidResult render_pyramid(const RenderInputs& in, const PreparedPyramid& prepared, Backend backend);
+
+// Both steps.
 PyramidResult render_pyramid(const RenderInputs& in, int levels, Backend backend);
 
 }  // namespace nebula

@@ -5,6 +5,7 @@
 
 #include "core/philox.h"
 #include "illumination/optical_depth_bake.h"
+#include "raycast/pyramid_render.h"
 #include "raycast/renderer.h"
 #include "scene/density_sources.h"
 #include "tables/scattering_table.h"
@@ -107,42 +108,62 @@ BakeBenchResult bench_bake(Backend backend, int size, int stars, int repeats) {
   return r;
 }
 
-std::vector<RenderBenchRow> bench_render(Backend backend, int size, int width, int height, int max_stars,
-                                         int repeats) {
-  // The procedural nebula of the 2005 paper's section 4.3 (scene/), its
-  // default parameters at size^3 voxels over a 2 pc cube.
-  ProceduralParams pp;
-  pp.n = size;
-  const DensityGrid grid = procedural_nebula(pp);
-  const Vec3 centre = procedural_star_position(pp);
-  TabulateParams tp;
-  tp.photons_per_row = 10000;
-  tp.binning = AngularBinning::UniformTheta;
-  const Tabulation tab = tabulate(tp, backend);
-  ScatteringTable table = ScatteringTable::make_axes(tp.tau_max, tp.tau_bins, tp.binning, tp.mu_bins);
-  for (size_t e = 0; e < tab.P.size(); ++e) table.P[e] = static_cast<float>(tab.P[e]);
+namespace {
 
-  CameraSettings cs;
-  cs.position = centre + Vec3{0.4f, -3.2f, 1.1f};
-  cs.look_at = centre;
-  cs.up = {0, 0, 1};
-  cs.fov_deg = 45;
-  cs.width = width;
-  cs.height = height;
-  std::vector<RenderBenchRow> rows;
-  for (int stars = 1; stars <= max_stars; stars *= 2) {
-    std::vector<Vec3> positions;
-    for (int k = 0; k < stars; ++k)
-      positions.push_back(k == 0 ? centre
-                                 : centre + Vec3{0.5f * std::cos(1.3f * k), 0.5f * std::sin(1.3f * k),
-                                                 0.1f * k - 0.4f});
-    const BakeResult bake = bake_star_depths(grid, positions, backend);
+// The procedural nebula of the 2005 paper's section 4.3 (scene/), its
+// default parameters at size^3 voxels over a 2 pc cube, a table tabulated on
+// the same backend (a = g = 0.6, 10^4 photons per row) and a perspective
+// camera outside the cloud.
+struct BenchNebula {
+  DensityGrid grid;
+  Vec3 centre;
+  ScatteringTable table;
+  CameraSettings camera;
+  BenchNebula(Backend backend, int size, int width, int height) {
+    ProceduralParams pp;
+    pp.n = size;
+    grid = procedural_nebula(pp);
+    centre = procedural_star_position(pp);
+    TabulateParams tp;
+    tp.photons_per_row = 10000;
+    tp.binning = AngularBinning::UniformTheta;
+    const Tabulation tab = tabulate(tp, backend);
+    table = ScatteringTable::make_axes(tp.tau_max, tp.tau_bins, tp.binning, tp.mu_bins);
+    for (size_t e = 0; e < tab.P.size(); ++e) table.P[e] = static_cast<float>(tab.P[e]);
+    camera.position = centre + Vec3{0.4f, -3.2f, 1.1f};
+    camera.look_at = centre;
+    camera.up = {0, 0, 1};
+    camera.fov_deg = 45;
+    camera.width = width;
+    camera.height = height;
+  }
+  // Star k: the first at the nebula's star, the others around it.
+  Vec3 star(int k) const {
+    return k == 0 ? centre : centre + Vec3{0.5f * std::cos(1.3f * k), 0.5f * std::sin(1.3f * k), 0.1f * k - 0.4f};
+  }
+  RenderInputs inputs(const std::vector<Vec3>& positions, const BakeResult& bake) const {
     RenderInputs in;
     in.density = &grid;
     const float ratios[3] = {1.2f, 1.0f, 0.85f};
     for (int b = 0; b < 3; ++b) in.bands.push_back(RenderBand{std::string(1, "BVR"[b]), ratios[b], 0.6f, &table, nullptr});
-    for (int k = 0; k < stars; ++k) in.stars.push_back(RenderStar{positions[k], {1e3f, 1e3f, 1e3f}, &bake.tau_v[k]});
-    in.camera = make_camera(cs);
+    for (size_t k = 0; k < positions.size(); ++k)
+      in.stars.push_back(RenderStar{positions[k], {1e3f, 1e3f, 1e3f}, &bake.tau_v[k]});
+    in.camera = make_camera(camera);
+    return in;
+  }
+};
+
+}  // namespace
+
+std::vector<RenderBenchRow> bench_render(Backend backend, int size, int width, int height, int max_stars,
+                                         int repeats) {
+  const BenchNebula nebula(backend, size, width, height);
+  std::vector<RenderBenchRow> rows;
+  for (int stars = 1; stars <= max_stars; stars *= 2) {
+    std::vector<Vec3> positions;
+    for (int k = 0; k < stars; ++k) positions.push_back(nebula.star(k));
+    const BakeResult bake = bake_star_depths(nebula.grid, positions, backend);
+    const RenderInputs in = nebula.inputs(positions, bake);
     RenderStats stats;
     render(in, backend, &stats);  // warm-up
     std::vector<double> times;
@@ -161,6 +182,30 @@ std::vector<RenderBenchRow> bench_render(Backend backend, int size, int width, i
     rows.push_back(row);
   }
   return rows;
+}
+
+PyramidBench bench_pyramid(Backend backend, int size, int width, int height, int levels, int repeats) {
+  const BenchNebula nebula(backend, size, width, height);
+  const std::vector<Vec3> positions{nebula.star(0)};
+  const BakeResult bake = bake_star_depths(nebula.grid, positions, backend);
+  const RenderInputs in = nebula.inputs(positions, bake);
+  PyramidBench out;
+  out.backend = to_string(backend);
+  out.size = size;
+  out.bake_seconds = bake.seconds;
+  const PreparedPyramid prepared = prepare_pyramid(in, levels, backend);
+  render_pyramid(in, prepared, backend);  // warm-up
+  std::vector<std::vector<double>> render_times(levels + 1);
+  std::vector<double> combine_times;
+  for (int i = 0; i < repeats; ++i) {
+    const PyramidResult r = render_pyramid(in, prepared, backend);
+    for (int j = 0; j <= levels; ++j) render_times[j].push_back(r.report[j].render_seconds);
+    combine_times.push_back(r.combine_seconds);
+    if (i == 0) out.levels = r.report;
+  }
+  for (int j = 0; j <= levels; ++j) out.levels[j].render_seconds = median_of(render_times[j]);
+  out.combine_seconds = median_of(combine_times);
+  return out;
 }
 
 }  // namespace nebula

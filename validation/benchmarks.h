@@ -7,6 +7,7 @@
 
 #include "core/backend.h"
 #include "montecarlo/tabulate.h"
+#include "raycast/pyramid_render.h"
 
 namespace nebula {
 
@@ -64,5 +65,17 @@ struct RenderBenchRow {
 // on the same backend (a = g = 0.6, 10^4 photons per row).
 std::vector<RenderBenchRow> bench_render(Backend backend, int size, int width, int height, int max_stars,
                                          int repeats);
+
+// The cost of each pyramid level on the same nebula with one star: the
+// one-time build and bake per level, and per frame the median render time of
+// each level (1/2^j resolution) and of the host-side combination.
+struct PyramidBench {
+  std::string backend;
+  int size = 0;
+  double bake_seconds = 0;                 // level 0's bake
+  std::vector<PyramidLevelReport> levels;  // render_seconds: medians
+  double combine_seconds = 0;              // median, on the host
+};
+PyramidBench bench_pyramid(Backend backend, int size, int width, int height, int levels, int repeats);
 
 }  // namespace nebula
