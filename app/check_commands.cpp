@@ -253,7 +253,7 @@ void add_bench_command(CLI::App& app) {
                   r.shape.nz, r.width, r.height, 1e3 * r.pyramid_seconds, 1e3 * r.bake_seconds,
                   1e3 * r.render_seconds, 1e3 * (frame + (r.level > 0 ? b.combine_seconds : 0)));
     }
-    std::printf("combination on the host (down, clipped difference, up, add): %.3f ms per frame\n",
+    std::printf("combination (down, clipped difference, up, add; on the %s): %.3f ms per frame\n", b.backend.c_str(),
                 1e3 * b.combine_seconds);
   });
 }

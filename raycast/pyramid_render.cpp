@@ -49,7 +49,22 @@ PreparedPyramid prepare_pyramid(const RenderInputs& in, int levels, Backend back
   return out;
 }
 
-PyramidResult render_pyramid(const RenderInputs& in, const PreparedPyramid& prepared, Backend backend) {
+RenderInputs level_inputs(const RenderInputs& in, const PyramidLevelData& level, const Camera& camera) {
+  if (level.emission.size() != in.bands.size() || level.depth.size() != in.stars.size())
+    throw Error("pyramid: level " + std::to_string(level.report.level) + " was prepared for other bands or stars");
+  RenderInputs out = in;
+  out.progress = nullptr;
+  out.density = &level.density;
+  for (size_t b = 0; b < in.bands.size(); ++b)
+    out.bands[b].emission = level.emission[b].empty() ? nullptr : &level.emission[b];
+  for (size_t k = 0; k < in.stars.size(); ++k) out.stars[k].depth_v = &level.depth[k];
+  out.camera = camera;
+  return out;
+}
+
+PyramidResult render_pyramid(const RenderInputs& in, const PreparedPyramid& prepared, Backend backend,
+                             bool keep_levels) {
+  if (backend == Backend::Cuda && !prepared.levels.empty()) return render_pyramid_cuda(in, prepared, keep_levels);
   PyramidResult out;
   RenderStats stats;
   out.levels.push_back(render(in, backend, &stats));
@@ -60,37 +75,26 @@ PyramidResult render_pyramid(const RenderInputs& in, const PreparedPyramid& prep
   r0.render_seconds = stats.seconds;
   r0.table_clamps = stats.table_clamps;
   out.report.push_back(r0);
-  if (prepared.levels.empty()) {
-    out.image = out.levels[0];
-    return out;
-  }
-  RenderInputs level_in = in;
-  level_in.progress = nullptr;
+  Camera camera = in.camera;
   for (const PyramidLevelData& level : prepared.levels) {
-    if (level.emission.size() != in.bands.size() || level.depth.size() != in.stars.size())
-      throw Error("pyramid: level " + std::to_string(level.report.level) + " was prepared for other bands or stars");
-    level_in.density = &level.density;
-    for (size_t b = 0; b < in.bands.size(); ++b)
-      level_in.bands[b].emission = level.emission[b].empty() ? nullptr : &level.emission[b];
-    for (size_t k = 0; k < in.stars.size(); ++k) level_in.stars[k].depth_v = &level.depth[k];
-    level_in.camera = coarser_camera(level_in.camera);
-    out.levels.push_back(render(level_in, backend, &stats));
+    camera = coarser_camera(camera);
+    out.levels.push_back(render(level_inputs(in, level, camera), backend, &stats));
     PyramidLevelReport r = level.report;
-    r.width = level_in.camera.width;
-    r.height = level_in.camera.height;
+    r.width = camera.width;
+    r.height = camera.height;
     r.render_seconds = stats.seconds;
     r.table_clamps = stats.table_clamps;
     out.report.push_back(r);
   }
   const auto t0 = std::chrono::steady_clock::now();
-  out.image = combine_pyramid(out.levels, &out.differences);
+  out.image = combine_pyramid(out.levels);
   out.combine_seconds = seconds_since(t0);
   return out;
 }
 
-PyramidResult render_pyramid(const RenderInputs& in, int levels, Backend backend) {
+PyramidResult render_pyramid(const RenderInputs& in, int levels, Backend backend, bool keep_levels) {
   const PreparedPyramid prepared = prepare_pyramid(in, levels, backend);
-  return render_pyramid(in, prepared, backend);
+  return render_pyramid(in, prepared, backend, keep_levels);
 }
 
 }  // namespace nebula

@@ -24,11 +24,10 @@ struct PyramidLevelReport {
 };
 
 struct PyramidResult {
-  Image image;                      // I_0 + the up-sampled clipped differences
-  std::vector<Image> levels;        // I_0 .. I_n (I_j at 1/2^j resolution)
-  std::vector<Image> differences;   // dI_1 .. dI_n at their levels' sizes (index 0 empty)
+  Image image;                // I_0 + the up-sampled clipped differences
+  std::vector<Image> levels;  // I_0 .. I_n (I_j at 1/2^j resolution); on the GPU only when asked for
   std::vector<PyramidLevelReport> report;  // one per level, 0 first
-  double combine_seconds = 0;
+  double combine_seconds = 0;              // host clock on the CPU, CUDA events on the GPU
 };
 
 // The coarser levels' volumes, emission and star bakes: what a camera move
@@ -49,10 +48,17 @@ PreparedPyramid prepare_pyramid(const RenderInputs& in, int levels, Backend back
 
 // One frame: level 0 from `in`, the coarser levels from `prepared` (built for
 // the same grid, bands and stars), each at 1/2^j of in.camera's resolution.
-// No levels gives exactly render(in, backend).
-PyramidResult render_pyramid(const RenderInputs& in, const PreparedPyramid& prepared, Backend backend);
+// No levels gives exactly render(in, backend). On the GPU the level images
+// stay on the device and are combined there; keep_levels downloads them too.
+PyramidResult render_pyramid(const RenderInputs& in, const PreparedPyramid& prepared, Backend backend,
+                             bool keep_levels = false);
+PyramidResult render_pyramid_cuda(const RenderInputs& in, const PreparedPyramid& prepared, bool keep_levels);
+
+// Level j's render inputs: `in` with the level's grid, emission and bakes and
+// the camera `camera` (in.camera made coarser j times).
+RenderInputs level_inputs(const RenderInputs& in, const PyramidLevelData& level, const Camera& camera);
 
 // Both steps.
-PyramidResult render_pyramid(const RenderInputs& in, int levels, Backend backend);
+PyramidResult render_pyramid(const RenderInputs& in, int levels, Backend backend, bool keep_levels = false);
 
 }  // namespace nebula

@@ -62,8 +62,8 @@ TEST(RendererGpu, AgreesWithTheCpu) {
   }
 }
 
-// The pyramid on the GPU: bakes and renders every level there; the same
-// combination on the host. Levels add up, so the tolerance is the exact
+// The pyramid on the GPU: bakes, renders and combines every level there
+// (the combination's per-pixel steps are multires/pyramid_pixels.h on both). Levels add up, so the tolerance is the exact
 // mode's 1e-4 of the peak per level.
 TEST(RendererGpu, PyramidAgreesWithTheCpu) {
   std::string why;
@@ -82,7 +82,9 @@ TEST(RendererGpu, PyramidAgreesWithTheCpu) {
   cs.height = 61;
   s.finish({0.1f, 0.2f, -0.1f}, 100.0f, 0.6f, make_camera(cs));
   const PyramidResult cpu = render_pyramid(s.inputs, 3, Backend::Cpu);
-  const PyramidResult gpu = render_pyramid(s.inputs, 3, Backend::Cuda);
+  const PyramidResult gpu = render_pyramid(s.inputs, 3, Backend::Cuda, true);
+  ASSERT_EQ(gpu.levels.size(), 4u);
+  EXPECT_EQ(gpu.levels[3].width, cpu.levels[3].width);
   double peak = 0, worst = 0;
   for (size_t i = 0; i < cpu.image.pixels.size(); ++i) {
     peak = std::max(peak, double(cpu.image.pixels[i]));

@@ -1,15 +1,17 @@
 #!/usr/bin/env python3
-"""The 2005 paper's Fig. 12 parameter study, from one scene.
+"""Image studies after the 2005 paper, each from one scene.
 
-Renders scenes/fig12_reference.toml (a = 0.6, g = 0.6, R_V = 5, an O5V star)
-and four variants, each changing one thing: R_V = 3.1, a Sun-like (G2V) star
-of the same luminosity, albedo 0.8, g = 0.8. Every image has the same
-exposure, so brightness and colour compare directly. Writes one PNG per
-variant (into --renders) and a montage (into --out).
+--study fig12 (Fig. 12): renders scenes/fig12_reference.toml (a = 0.6,
+g = 0.6, R_V = 5, an O5V star) and four variants, each changing one thing:
+R_V = 3.1, a Sun-like (G2V) star of the same luminosity, albedo 0.8, g = 0.8.
+--study pyramid (Fig. 9): the same scene with 0, 1, 2 and 3 pyramid levels.
+Every image has the same exposure, so brightness and colour compare
+directly. Writes one PNG per variant (into --renders) and a montage (into
+--out).
 
-Usage: /usr/bin/python3 validation/gallery.py [--nebula build/bin/nebula]
-           [--scene scenes/fig12_reference.toml] [--out docs/images]
-           [--size 384] [--backend auto]
+Usage: /usr/bin/python3 validation/gallery.py [--study fig12|pyramid]
+           [--nebula build/bin/nebula] [--scene scenes/fig12_reference.toml]
+           [--out docs/images] [--size 384] [--backend auto]
 Needs numpy and matplotlib (Debian: python3-numpy, python3-matplotlib).
 """
 import argparse
@@ -17,13 +19,21 @@ import os
 import subprocess
 import sys
 
-VARIANTS = [
-    ("reference", "reference\na = 0.6, g = 0.6, R_V = 5, O5V", []),
-    ("rv31", "R_V = 3.1", ["dust.R_V=3.1"]),
-    ("sunlike", "Sun-like star (G2V)", ['stars.0.class="G2V"']),
-    ("albedo08", "albedo a = 0.8", ["dust.albedo=0.8"]),
-    ("g08", "anisotropy g = 0.8", ["dust.g=0.8"]),
-]
+# study: (montage file, title, [(key, panel title, extra render arguments)])
+STUDIES = {
+    "fig12": ("fig12_study.png", "Parameter study after Magnor et al. 2005, Fig. 12 (same exposure throughout)", [
+        ("reference", "reference\na = 0.6, g = 0.6, R_V = 5, O5V", []),
+        ("rv31", "R_V = 3.1", ["--set", "dust.R_V=3.1"]),
+        ("sunlike", "Sun-like star (G2V)", ["--set", 'stars.0.class="G2V"']),
+        ("albedo08", "albedo a = 0.8", ["--set", "dust.albedo=0.8"]),
+        ("g08", "anisotropy g = 0.8", ["--set", "dust.g=0.8"]),
+    ]),
+    "pyramid": ("pyramid_levels.png",
+                "Wide-range multiple scattering: 0 to 3 pyramid levels, after Magnor et al. 2005, Fig. 9", [
+        (f"levels{n}", f"{n} level{'s' if n != 1 else ''}" + (" (plain render)" if n == 0 else ""),
+         ["--levels", str(n)]) for n in range(4)
+    ]),
+}
 
 
 def fail(message):
@@ -33,6 +43,7 @@ def fail(message):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--study", default="fig12", choices=sorted(STUDIES))
     parser.add_argument("--nebula", default="build/bin/nebula")
     parser.add_argument("--scene", default="scenes/fig12_reference.toml")
     parser.add_argument("--out", default="docs/images", help="folder for the montage")
@@ -55,13 +66,12 @@ def main():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    montage_name, suptitle, variants = STUDIES[args.study]
     panels = []
-    for key, title, overrides in VARIANTS:
-        path = os.path.join(args.renders, f"fig12_{key}.png")
+    for key, title, extra in variants:
+        path = os.path.join(args.renders, f"{args.study}_{key}.png")
         command = [args.nebula, "render", args.scene, "-o", path, "--force", "-q",
-                   "--backend", args.backend, "--width", str(args.size), "--height", str(args.size)]
-        for o in overrides:
-            command += ["--set", o]
+                   "--backend", args.backend, "--width", str(args.size), "--height", str(args.size)] + extra
         print("$", " ".join(command), flush=True)
         result = subprocess.run(command, capture_output=True, text=True)
         if result.returncode != 0:
@@ -73,9 +83,9 @@ def main():
         ax.imshow(plt.imread(path))
         ax.set_title(title, fontsize=10)
         ax.axis("off")
-    fig.suptitle("Parameter study after Magnor et al. 2005, Fig. 12 (same exposure throughout)")
+    fig.suptitle(suptitle)
     fig.tight_layout()
-    montage = os.path.join(args.out, "fig12_study.png")
+    montage = os.path.join(args.out, montage_name)
     fig.savefig(montage + ".tmp.png")
     os.replace(montage + ".tmp.png", montage)
     print(f"wrote {montage}")
