@@ -52,16 +52,23 @@ file(WRITE ${WORK}/scene_with_typo.toml
      "[density]\nprocedural = { n = 8 }\n[[stars]]\nluminosity_lsun = 1.0\nclass = \"G2V\"\n[camera]\nzoom = 3\n")
 expect_failure(render_unknown_key "camera.zoom" render scene_with_typo.toml -o bad.h5)
 expect_failure(render_missing_scene "missing.toml" render missing.toml -o bad.h5)
+expect_failure(render_levels_negative "--levels" render --demo --levels -2 -o bad.h5)
+expect_failure(render_levels_too_many "--levels: 9 exceeds the 6" render --demo --levels 9 -o bad.h5)
+file(WRITE ${WORK}/scene_levels.toml
+     "[density]\nprocedural = { n = 8 }\n[[stars]]\nluminosity_lsun = 1.0\nclass = \"G2V\"\n[camera]\n"
+     "position = [0.5, -3, 1]\nlook_at = [1, 1, 1]\n[render]\nlevels = 3\n")
+expect_failure(render_levels_scene "render.levels: 3 exceeds the 2" render scene_levels.toml -o bad.h5)
 # A small real render (tables generated into the scratch cache).
 execute_process(COMMAND ${NEBULA} render ${SOURCE}/scenes/uniform_sphere.toml --width 24 --height 24
-                        --table-photons 2000 --backend cpu -q -o sphere.h5
+                        --table-photons 2000 --backend cpu -q --levels 2 -o sphere.h5
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err WORKING_DIRECTORY ${WORK})
 if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/sphere.h5)
   message(FATAL_ERROR "render failed (${rc}): ${out} ${err}")
 endif()
 string(FIND "${out}" "computed, and why" at)
-if(at EQUAL -1)
-  message(FATAL_ERROR "render printed no account of what it computed: ${out}")
+string(FIND "${out}" "pyramid level 2:" level_at)
+if(at EQUAL -1 OR level_at EQUAL -1)
+  message(FATAL_ERROR "render printed no account of what it computed (and its 2 pyramid levels): ${out}")
 endif()
 
 # A good run, then the overwrite rule.
