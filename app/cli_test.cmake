@@ -64,6 +64,36 @@ if(at EQUAL -1)
   message(FATAL_ERROR "render printed no account of what it computed: ${out}")
 endif()
 
+# The ground truth and the comparison: bad requests fail before any work, with one line.
+set(sphere ${SOURCE}/scenes/uniform_sphere.toml)
+expect_failure(truth_no_spp "--spp" truth ${sphere} -o bad.h5)
+expect_failure(truth_spp_one "--spp" truth ${sphere} --spp 1 -o bad.h5)
+expect_failure(truth_spp_text "--spp" truth ${sphere} --spp many -o bad.h5)
+expect_failure(truth_extension "unknown image format" truth ${sphere} --spp 4 -o bad.jpg)
+expect_failure(truth_orders "--max-orders" truth ${sphere} --spp 4 --max-orders -1 -o bad.h5)
+expect_failure(truth_block "--majorant-block" truth ${sphere} --spp 4 --majorant-block 0 -o bad.h5)
+expect_failure(truth_missing_scene "missing.toml" truth missing.toml --spp 4 -o bad.h5)
+expect_failure(truth_unknown_key "camera.zoom" truth scene_with_typo.toml --spp 4 -o bad.h5)
+expect_failure(truth_backend "--backend" truth ${sphere} --spp 4 --backend tpu -o bad.h5)
+execute_process(COMMAND ${NEBULA} truth ${sphere} --spp 4 --width 12 --height 10 --backend cpu -q -o truth.h5
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err WORKING_DIRECTORY ${WORK})
+if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/truth.h5 OR NOT EXISTS ${WORK}/truth.var.h5)
+  message(FATAL_ERROR "truth failed (${rc}): ${out} ${err}")
+endif()
+expect_failure(truth_exists "--force" truth ${sphere} --spp 4 --width 12 --height 10 --backend cpu -q -o truth.h5)
+expect_failure(compare_missing "missing.h5" compare missing.h5 truth.h5)
+expect_failure(compare_size "sphere.h5" compare sphere.h5 truth.h5)
+expect_failure(compare_diff_format "--diff" compare truth.h5 truth.h5 --diff bad.jpg)
+expect_failure(compare_signal "--signal" compare truth.h5 truth.h5 --signal 2)
+execute_process(COMMAND ${NEBULA} compare truth.h5 truth.h5 --json
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err WORKING_DIRECTORY ${WORK})
+foreach(key rel_l1 rel_l2 worst_1pct bias within_noise noise_rel_l2)
+  string(FIND "${out}" "\"${key}\":" at)
+  if(NOT rc EQUAL 0 OR at EQUAL -1)
+    message(FATAL_ERROR "compare --json lacks ${key} (${rc}): ${out} ${err}")
+  endif()
+endforeach()
+
 # A good run, then the overwrite rule.
 execute_process(COMMAND ${NEBULA} tabulate ${small} -o good.h5 RESULT_VARIABLE rc OUTPUT_VARIABLE out
                 WORKING_DIRECTORY ${WORK})
