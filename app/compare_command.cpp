@@ -51,12 +51,12 @@ void run_compare(const Options& o) {
   }
   std::printf("%s against %s%s%s; pixels with signal: reference above %g of its peak\n", o.a.c_str(), o.b.c_str(),
               has_b ? " (variance " : "", has_b ? (vb + ")").c_str() : "", o.signal);
-  std::printf("%-5s %8s %10s %10s %10s %10s %10s %10s %8s %s\n", "band", "pixels", "rel L1", "rel L2", "worst 1%",
-              "bias", "noise L2", "excess L2", "mean z2", "within noise");
+  std::printf("%-5s %8s %10s %10s %10s %20s %10s %10s %8s %s\n", "band", "pixels", "rel L1", "rel L2", "worst 1%",
+              "bias +- stderr", "noise L2", "excess L2", "mean z2", "within noise");
   for (const BandComparison& r : c.bands)
-    std::printf("%-5s %8zu %10.4g %10.4g %10.4g %+10.4g %10.4g %10.4g %8.3g %s\n", r.band.c_str(), r.signal_pixels,
-                r.rel_l1, r.rel_l2, r.worst_1pct, r.bias, r.noise_rel_l2, r.rel_l2_excess, r.mean_z2,
-                r.has_variance ? (r.within_noise ? "yes" : "no") : "(no variance image)");
+    std::printf("%-5s %8zu %10.4g %10.4g %10.4g %+10.4g +- %-6.2g %10.4g %10.4g %8.3g %s\n", r.band.c_str(),
+                r.signal_pixels, r.rel_l1, r.rel_l2, r.worst_1pct, r.bias, r.bias_stderr, r.noise_rel_l2,
+                r.rel_l2_excess, r.mean_z2, r.has_variance ? (r.within_noise ? "yes" : "no") : "(no variance image)");
   if (!o.diff.empty()) {
     std::printf("wrote %s: white equal, red A brighter, blue A darker; full colour at", o.diff.c_str());
     for (size_t k = 0; k < ranges.size(); ++k) std::printf(" %s +-%.3g", c.bands[k].band.c_str(), ranges[k]);

@@ -82,6 +82,7 @@ Comparison compare_images(const Image& a, const Image& b, const Image* var_a, co
       r.bias = signed_sum / ref1;
       if (r.has_variance) {
         r.noise_rel_l2 = std::sqrt(var_sum / ref2);
+        r.bias_stderr = std::sqrt(var_sum) / ref1;
         r.rel_l2_excess = std::sqrt(std::max(0.0, l2 - var_sum) / ref2);
       }
     }
@@ -102,9 +103,9 @@ std::string to_json(const Comparison& c) {
     const BandComparison& r = c.bands[i];
     std::snprintf(buf, sizeof buf,
                   "%s{\"band\": \"%s\", \"signal_pixels\": %zu, \"rel_l1\": %.9g, \"rel_l2\": %.9g, "
-                  "\"worst_1pct\": %.9g, \"bias\": %.9g, \"has_variance\": %s, \"noise_rel_l2\": %.9g, "
+                  "\"worst_1pct\": %.9g, \"bias\": %.9g, \"bias_stderr\": %.9g, \"has_variance\": %s, \"noise_rel_l2\": %.9g, "
                   "\"rel_l2_excess\": %.9g, \"mean_z2\": %.9g, \"beyond_4sigma\": %.9g, \"within_noise\": %s}",
-                  i ? ", " : "", r.band.c_str(), r.signal_pixels, r.rel_l1, r.rel_l2, r.worst_1pct, r.bias,
+                  i ? ", " : "", r.band.c_str(), r.signal_pixels, r.rel_l1, r.rel_l2, r.worst_1pct, r.bias, r.bias_stderr,
                   r.has_variance ? "true" : "false", r.noise_rel_l2, r.rel_l2_excess, r.mean_z2, r.beyond_4sigma,
                   r.has_variance ? (r.within_noise ? "true" : "false") : "null");
     s += buf;

@@ -15,6 +15,7 @@ struct BandComparison {
   double rel_l2 = 0;          // sqrt(sum (A - B)^2 / sum B^2)
   double worst_1pct = 0;      // 99th percentile of |A - B| / B over signal pixels
   double bias = 0;            // sum (A - B) / sum B (mean signed error, relative)
+  double bias_stderr = 0;     // its standard error from the variance images: sqrt(sum var) / sum B
   // With variance images (B's, plus A's when it has one):
   bool has_variance = false;
   double noise_rel_l2 = 0;    // sqrt(sum var / sum B^2): the L2 error noise alone would give
