@@ -28,6 +28,7 @@ struct Options {
   std::string scene_path, out, backend = "auto", spp;
   std::vector<std::string> overrides;
   bool demo = false, force = false, quiet = false;
+  std::string transmittance = "ratio";
   int width = 0, height = 0, max_orders = 0, majorant_block = 4;
   uint64_t seed = 1;
 };
@@ -41,6 +42,8 @@ void run_truth(const Options& o) {
   if (o.max_orders < 0) throw Error("--max-orders: must be 0 (all orders) or positive");
   if (o.majorant_block < 1 || o.majorant_block > 256) throw Error("--majorant-block: must be 1 to 256 voxels");
   if (o.width < 0 || o.height < 0) throw Error("--width/--height: must be positive");
+  if (o.transmittance != "ratio" && o.transmittance != "exact")
+    throw Error("--transmittance: expected ratio or exact, got '" + o.transmittance + "'");
   Scene scene = o.demo ? demo_scene() : load_scene(o.scene_path, o.overrides);
   if (o.width > 0) scene.camera.width = o.width;
   if (o.height > 0) scene.camera.height = o.height;
@@ -66,6 +69,7 @@ void run_truth(const Options& o) {
   in.seed = o.seed;
   in.max_orders = o.max_orders;
   in.majorant_block = o.majorant_block;
+  in.exact_transmittance = o.transmittance == "exact";
   std::unique_ptr<Progress> progress;
   if (!o.quiet && backend == Backend::Cpu) progress = std::make_unique<Progress>("truth", uint64_t(camera.height));
   in.progress = progress.get();
@@ -90,7 +94,8 @@ void run_truth(const Options& o) {
   }
   meta.entries.push_back({"R_V", to_text(scene.dust.R_V)});
   meta.entries.push_back({"scene", scene.path});
-  meta.entries.push_back({"mode", "truth spp " + std::to_string(spp) + " seed " + std::to_string(o.seed) +
+  meta.entries.push_back({"mode", "truth spp " + std::to_string(spp) + " seed " + std::to_string(o.seed) + " " +
+                                      o.transmittance + " transmittance" +
                                       (o.max_orders ? " orders<=" + std::to_string(o.max_orders) : "")});
   ImageMetadata var_meta = meta;
   var_meta.units = "(L_sun pc^-2 sr^-1 x exposure)^2, variance of the pixel mean";
@@ -126,6 +131,9 @@ void add_truth_command(CLI::App& app) {
   cmd->add_option("--seed", o->seed, "Philox key")->capture_default_str();
   cmd->add_option("--max-orders", o->max_orders, "scattering orders kept (0: all, the truth)")->capture_default_str();
   cmd->add_option("--majorant-block", o->majorant_block, "voxels per majorant-grid block edge")->capture_default_str();
+  cmd->add_option("--transmittance", o->transmittance,
+                  "to the stars: ratio (residual ratio tracking) or exact (the voxel sum: no noise)")
+      ->capture_default_str();
   cmd->add_flag("--force", o->force, "overwrite existing outputs");
   cmd->add_flag("-q,--quiet", o->quiet, "no progress bar");
   cmd->callback([o] { run_truth(*o); });

@@ -66,6 +66,7 @@ struct PathScene {
   uint64_t seed = 1;
   int max_orders = 0;      // 0: unlimited (the truth); k > 0: orders 1..k only (tests, studies)
   int roulette_start = 3;  // collisions before Russian roulette plays
+  bool exact_transmittance = false;  // NEE: exact DDA sum over voxels instead of ratio tracking
 };
 
 struct PathCounters {
@@ -234,7 +235,9 @@ NEBULA_HD float trace_path(const PathScene& s, int b, Vec3 origin, Vec3 dir, Rng
       const float r2 = dot(d, d);
       if (!(r2 > near2) || !(star.power[b] > 0.0f)) continue;
       const float mu = dot(d, -dir) / sqrtf(r2);  // after scattering it goes back along the path
-      const float t = ratio_track(s, scale, pos, star.position, rng, c);
+      const float t = s.exact_transmittance
+                          ? expf(-s.extinction_ratio[b] * segment_optical_depth(s.density, pos, star.position))
+                          : ratio_track(s, scale, pos, star.position, rng, c);
       radiance += weight * a * star.power[b] * kInv4Pi / r2 * t * hg_phase(g, mu);
     }
     if (s.max_orders > 0 && order >= s.max_orders) break;

@@ -11,6 +11,7 @@
 #include "montecarlo/henyey_greenstein.h"
 #include "raycast/renderer.h"
 #include "raycast/test_scenes.h"
+#include "validation/image_compare.h"
 #include "validation/truth_renderer.h"
 
 namespace nebula {
@@ -311,6 +312,28 @@ TEST(PathTracer, AgreesWithTheFastRendererInTheThinLimit) {
   std::printf("thin limit: fast %.6g, truth %.6g +- %.2g (bias bound %.2g)\n", sum_fast, sum_truth, se, bias);
   EXPECT_NEAR(sum_truth, sum_fast, 4 * se + bias);
   EXPECT_LT(4 * se, 0.05 * sum_fast);  // the test has teeth
+}
+
+// Next-event transmittance by ratio tracking or by the exact voxel sum: two
+// unbiased estimators of one image, equal within their combined noise.
+TEST(PathTracer, ExactAndRatioTrackedTransmittanceAgree) {
+  DensityGrid g = noise_grid(12, 1.0f, 1.0f, 51);
+  TruthInputs in;
+  in.density = &g;
+  in.bands = {TruthBand{"V", 1.0f, 0.8f, 0.5f, nullptr}};
+  in.stars = {TruthStar{{0.1f, 1.5f, 0.2f}, {100.0f}}};
+  in.camera = telescope(16, 2.0f);
+  in.spp = 64;
+  const TruthOutput ratio = render_truth_cpu(in);
+  in.exact_transmittance = true;
+  in.seed = 7;
+  const TruthOutput exact = render_truth_cpu(in);
+  const BandComparison c = compare_images(ratio.image, exact.image, &ratio.variance, &exact.variance).bands[0];
+  std::printf("ratio vs exact transmittance: bias %+.4f +- %.4f, mean z^2 %.3f over %zu pixels\n", c.bias,
+              c.bias_stderr, c.mean_z2, c.signal_pixels);
+  EXPECT_GT(c.signal_pixels, 100u);
+  EXPECT_NEAR(c.bias, 0.0, 4 * c.bias_stderr);
+  EXPECT_TRUE(c.within_noise);
 }
 
 TEST(PathTracer, SameSeedSameImageAndNoNaN) {

@@ -41,6 +41,7 @@ struct TruthInputs {
   int max_orders = 0;      // 0: all orders (the truth)
   int roulette_start = 3;
   int majorant_block = 4;  // voxels per majorant block edge
+  bool exact_transmittance = false;  // NEE transmittance by the exact voxel sum (no noise) instead of ratio tracking
   Progress* progress = nullptr;  // advanced in image rows (CPU); may be null
 };
 
