@@ -76,9 +76,9 @@ class Runner:
             raise SystemExit(f"nebula {' '.join(argv)} failed ({r.returncode}): {r.stderr.strip()}")
         return r.stdout
 
-    def truth(self, scene, spp, seed, out):
+    def truth(self, scene, spp, seed, out, extra=()):
         text = self.run(["truth", scene, "--spp", str(spp), "--seed", str(seed), "--backend", self.backend, "-q",
-                         "--transmittance", self.transmittance, "--force", "-o", out])
+                         "--transmittance", self.transmittance, "--force", "-o", out] + list(extra))
         return float(re.search(r"tracing ([0-9.eE+-]+) s", text).group(1))
 
     def render(self, scene, out, extra):
@@ -92,12 +92,17 @@ class Runner:
         return c["bands"]
 
     def tabulate(self, out, photons, tau_bins, mu_bins):
-        if os.path.exists(out):
-            return 0.0
+        """Makes the table once; its generation time is kept beside it (out.seconds)."""
+        if os.path.exists(out) and os.path.exists(out + ".seconds"):
+            with open(out + ".seconds") as f:
+                return float(f.read())
         t0 = time.time()
         self.run(["tabulate", "--photons", str(photons), "--tau-bins", str(tau_bins), "--mu-bins", str(mu_bins),
-                  "--binning", "uniform-theta", "--backend", self.backend, "-q", "-o", out])
-        return time.time() - t0
+                  "--binning", "uniform-theta", "--backend", self.backend, "-q", "--force", "-o", out])
+        seconds = time.time() - t0
+        with open(out + ".seconds", "w") as f:
+            f.write(f"{seconds:.3f}\n")
+        return seconds
 
 
 def summarise(bands):
@@ -117,6 +122,13 @@ def study(r, name, args, rows, notes):
     t_ref = r.truth(scene, args.ref_spp, 1, ref)
     rows.append(dict(scene=name, method="truth (reference)", knob="spp", value=args.ref_spp, seconds=t_ref,
                      **summarise(r.compare(ref, ref))))
+    # Scattering orders: single scattering only (and up to 2), against the full truth: how much of the image
+    # is light scattered more than once.
+    for orders in (1, 2):
+        out = os.path.join(d, f"truth_orders_{orders}.h5")
+        t = r.truth(scene, args.orders_spp, 50 + orders, out, ["--max-orders", str(orders)])
+        rows.append(dict(scene=name, method="truth orders", knob="max orders", value=orders, seconds=t,
+                         **summarise(r.compare(out, ref))))
     for k, spp in enumerate(args.truth_spp):
         out = os.path.join(d, f"truth_{spp}.h5")
         t = r.truth(scene, spp, 100 + k, out)
@@ -151,6 +163,7 @@ def study(r, name, args, rows, notes):
 def plot(rows, images):
     os.makedirs(images, exist_ok=True)
     markers = {"truth": "o-", "fast": "s", "fast smooth": "^", "fast table": "D", "fast pyramid": "v"}
+    # (truth orders rows are a diagnostic of the scene, not a method: left out of this plot)
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     fig, axes = plt.subplots(1, len(scenes), figsize=(4 * len(scenes), 3.8), sharey=True)
     for ax, scene in zip(np.atleast_1d(axes), scenes):
@@ -192,6 +205,11 @@ def fmt(v):
     return f"{v:.3g}" if isinstance(v, float) else str(v)
 
 
+# What the numbers above mean; kept with the script so that a rerun keeps it (revise it when they change).
+FINDINGS = open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "accuracy_findings.md")).read() \
+    if os.path.exists(os.path.join(os.path.dirname(os.path.abspath(__file__)), "accuracy_findings.md")) else ""
+
+
 def write_markdown(rows, args, r, table_times, path, elapsed):
     machine = args.machine or f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores"
     out = []
@@ -218,6 +236,29 @@ def write_markdown(rows, args, r, table_times, path, elapsed):
                    "(another branch adds it); the script measures it automatically once it exists.*\n")
     out.append("Table generation (CPU, one-off, cached by the renderer): " +
                ", ".join(f"{k}: {v:.1f} s" for k, v in table_times.items()) + ".\n")
+    out.append("## Where the table method is biased, measured\n")
+    out.append("The fast renderer at its defaults (exact traversal, tables of "
+               f"{args.default_photons:g} photons per row, uniform-θ, no pyramid) against the truth; bias = "
+               "Σ(fast − truth)/Σtruth with its standard error from the truth's variance image (mean over bands), "
+               "and the L2 error beyond the truth's noise:\n")
+    out.append("| scene | bias | ± | excess rel L2 | worst 1% | truth noise (rel L2) | single scattering "
+               "/ truth | fast / single scattering |")
+    out.append("|---|---|---|---|---|---|---|---|")
+    for x in rows:
+        if x["method"] == "fast" and x["value"] == args.default_photons:
+            ref = [y for y in rows if y["scene"] == x["scene"] and y["method"] == "truth (reference)"][0]
+            ss = [y for y in rows if y["scene"] == x["scene"] and y["method"] == "truth orders" and y["value"] == 1]
+            ss_text = "—"
+            if ss:
+                # Sums over the reference's signal pixels: sum(ss)/sum(truth) = 1 + bias_ss.
+                ss_text = (f"{1 + ss[0]['bias']:.3f} | {(1 + x['bias']) / (1 + ss[0]['bias']):.3f}")
+            else:
+                ss_text = "— | —"
+            out.append(f"| {x['scene']} | {100 * x['bias']:+.1f}% | {100 * x['bias_stderr']:.1f}% | "
+                       f"{x['rel_l2_excess']:.3g} | {x['worst_1pct']:.3g} | {ref['noise_rel_l2'] / np.sqrt(2):.3g} | "
+                       f"{ss_text} |")
+    out.append("")
+    out.append(FINDINGS)
     for scene in dict.fromkeys(x["scene"] for x in rows):
         out.append(f"## {scene}\n")
         out.append("| method | knob | value | time s | rel L1 | rel L2 | worst 1% | bias | noise | excess |")
@@ -243,8 +284,9 @@ def main():
                    help="the truth's next-event transmittance: exact (voxel sum; 2x faster on 32^3 grids at equal "
                         "noise, measured) or ratio")
     p.add_argument("--scenes", nargs="*", default=SCENES)
-    p.add_argument("--ref-spp", type=int, default=512)
-    p.add_argument("--truth-spp", type=int, nargs="*", default=[4, 16, 64])
+    p.add_argument("--ref-spp", type=int, default=1024)
+    p.add_argument("--truth-spp", type=int, nargs="*", default=[4, 16, 64, 256])
+    p.add_argument("--orders-spp", type=int, default=256, help="spp of the single- and double-scattering runs")
     p.add_argument("--photons", type=int, nargs="*", default=[1000, 3000, 10000, 30000])
     p.add_argument("--default-photons", type=int, default=30000)
     p.add_argument("--steps", type=float, nargs="*", default=[1.0, 0.5, 0.25])
@@ -254,9 +296,19 @@ def main():
     p.add_argument("--machine", default="", help="how the report names the machine")
     p.add_argument("--note", default="64x64, grids 32^3")
     p.add_argument("--docs", default=os.path.join(ROOT, "docs"))
+    p.add_argument("--from-json", default="", help="rewrite the plots and the page from a run's results.json")
     args = p.parse_args()
     args.resolutions = [tuple(int(v) for v in s.split("x")) for s in args.resolutions]
     start = time.time()
+    if args.from_json:
+        # Only the plots and the page, from a finished run's results.
+        with open(args.from_json) as f:
+            saved = json.load(f)
+        r = argparse.Namespace(has_levels=saved["has_levels"])
+        plot(saved["rows"], os.path.join(args.docs, "images"))
+        write_markdown(saved["rows"], args, r, saved["table_times"], os.path.join(args.docs, "accuracy.md"),
+                       saved["elapsed"])
+        return 0
     write_densities(os.path.join(ROOT, "validation", "scenes"))
     r = Runner(args)
     table_times = {}
@@ -269,7 +321,8 @@ def main():
         print(f"{name} ...", flush=True)
         study(r, name, args, rows, None)
     with open(os.path.join(r.work, "results.json"), "w") as f:
-        json.dump(rows, f, indent=1)
+        json.dump(dict(rows=rows, table_times=table_times, has_levels=r.has_levels, elapsed=time.time() - start), f,
+                  indent=1)
     plot(rows, os.path.join(args.docs, "images"))
     write_markdown(rows, args, r, table_times, os.path.join(args.docs, "accuracy.md"), time.time() - start)
     print(f"wrote {os.path.join(args.docs, 'accuracy.md')} ({(time.time() - start) / 60:.1f} min)")
