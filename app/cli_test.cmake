@@ -76,6 +76,8 @@ expect_failure(truth_missing_scene "missing.toml" truth missing.toml --spp 4 -o 
 expect_failure(truth_unknown_key "camera.zoom" truth scene_with_typo.toml --spp 4 -o bad.h5)
 expect_failure(truth_backend "--backend" truth ${sphere} --spp 4 --backend tpu -o bad.h5)
 expect_failure(truth_transmittance "--transmittance" truth ${sphere} --spp 4 --transmittance guess -o bad.h5)
+expect_failure(bench_truth_spp "--spp" bench truth --backend cpu --spp 1)
+expect_failure(bench_truth_transmittance "--transmittance" bench truth --backend cpu --transmittance guess)
 execute_process(COMMAND ${NEBULA} truth ${sphere} --spp 4 --width 12 --height 10 --backend cpu -q -o truth.h5
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err WORKING_DIRECTORY ${WORK})
 if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/truth.h5 OR NOT EXISTS ${WORK}/truth.var.h5)

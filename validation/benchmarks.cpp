@@ -168,7 +168,8 @@ std::vector<RenderBenchRow> bench_render(Backend backend, int size, int width, i
 
 namespace nebula {
 
-TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int spp, int repeats) {
+TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int spp, int repeats,
+                          bool exact_transmittance) {
   ProceduralParams pp;
   pp.n = size;
   const DensityGrid grid = procedural_nebula(pp);
@@ -187,6 +188,7 @@ TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int 
   in.stars = {TruthStar{centre, {1e3f, 1e3f, 1e3f}}};
   in.camera = make_camera(cs);
   in.spp = spp;
+  in.exact_transmittance = exact_transmittance;
   TruthOutput out = render_truth(in, backend);  // warm-up
   std::vector<double> times;
   for (int i = 0; i < repeats; ++i) {

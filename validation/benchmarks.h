@@ -81,7 +81,9 @@ struct TruthBenchRow {
 
 // The path tracer on the procedural nebula (as bench_render: default
 // parameters at size^3 voxels, its star, the same camera), bands B, V, R with
-// a = g = 0.6; one warm-up, then `repeats` timed runs at `spp`.
-TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int spp, int repeats);
+// a = g = 0.6; one warm-up, then `repeats` timed runs at `spp`. Next-event
+// transmittance by ratio tracking, or by the exact voxel sum.
+TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int spp, int repeats,
+                          bool exact_transmittance = false);
 
 }  // namespace nebula
