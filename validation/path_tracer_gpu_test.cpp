@@ -27,7 +27,9 @@ TEST(TruthGpu, CpuAndCudaAgreeWithinTheirNoise) {
   TruthInputs in;
   in.density = &g;
   in.bands = {TruthBand{"B", 1.3f, 0.6f, 0.6f, nullptr}, TruthBand{"V", 1.0f, 0.9f, 0.3f, &j}};
-  in.stars = {TruthStar{{0.1f, 0.05f, 0.0f}, {1e3f, 8e2f}}, TruthStar{{0, 3, 0}, {1e3f, 1e3f}}};
+  // Stars outside the dust: a star inside it has heavy-tailed samples (docs/truth.md), which
+  // would make the chi-square test below depend on a few paths.
+  in.stars = {TruthStar{{0.1f, 0.05f, 1.4f}, {1e3f, 8e2f}}, TruthStar{{0, 3, 0}, {1e3f, 1e3f}}};
   CameraSettings cs;
   cs.position = {0.3f, -3.0f, 0.8f};
   cs.look_at = {0, 0, 0};
@@ -44,6 +46,7 @@ TEST(TruthGpu, CpuAndCudaAgreeWithinTheirNoise) {
                 r.noise_rel_l2, r.mean_z2, r.beyond_4sigma);
     EXPECT_GT(r.signal_pixels, 1000u);
     EXPECT_TRUE(r.within_noise);
+    EXPECT_NEAR(r.bias, 0.0, 4 * r.bias_stderr);
   }
   EXPECT_EQ(cpu.paths, gpu.paths);
   for (float v : gpu.image.pixels) EXPECT_TRUE(std::isfinite(v) && v >= 0);
