@@ -276,6 +276,42 @@ TEST(PathTracer, VanDeHulstSlabThroughTheGrid) {
   EXPECT_NEAR(Td.mean() + direct, 0.66096, 4 * Td.stderr_() + 1e-5);
 }
 
+// Chandrasekhar's semi-infinite, isotropically scattering medium (a = 0.8,
+// normal incidence): R = 1 - H(1) sqrt(1 - a) = 0.28525, the tabulator's
+// other reference case, through the grid as above. 40 voxels of tau_v = 1
+// stand for "semi-infinite": the light that would come back from below 40 mean
+// free paths is far below the noise (the diffuse light decays by
+// exp(-sqrt(3 (1 - a)) tau) = e^-31 there). Exercises the isotropic sampling
+// branch and high scattering orders with Russian roulette.
+TEST(PathTracer, SemiInfiniteIsotropicReflectanceThroughTheGrid) {
+  DensityGrid g;
+  g.shape.nx = g.shape.ny = 128;
+  g.shape.nz = 40;
+  g.shape.voxel = 1.0f;
+  g.shape.origin = {-64, -64, 0};
+  g.tau_v.assign(g.shape.count(), 1.0f);
+  const float D = 1e6f;
+  TruthInputs in;
+  in.density = &g;
+  in.bands = {TruthBand{"V", 1.0f, 0.8f, 0.0f, nullptr}};
+  in.stars = {TruthStar{{0, 0, 40 + D}, {float(4 * kPiD * double(D) * D)}}};
+  in.camera = telescope(4, 1.0f);
+  const HostPathScene h = prepare_path_scene(in);
+  Mean R;
+  PathCounters c;
+  for (int i = 0; i < 100000; ++i) {
+    const Uniform4 u = philox_uniform4(31, 0, uint32_t(i), 3, 0);
+    const float cos_t = std::sqrt(u.u0), sin_t = std::sqrt(1 - u.u0);
+    const Vec3 dir{sin_t * std::cos(2 * kPi * u.u1), sin_t * std::sin(2 * kPi * u.u1), -cos_t};
+    PathRng rng(32, uint32_t(i), 3, 0);
+    R.add(kPiD * trace_path(h.scene, 0, Vec3{0, 0, 40}, dir, rng, c));
+  }
+  std::printf("semi-infinite a=0.8 g=0: R = %.5f +- %.5f (0.28525), %.2f collisions per path\n", R.mean(),
+              R.stderr_(), double(c.vertices) / R.n);
+  EXPECT_EQ(c.capped, 0u);
+  EXPECT_NEAR(R.mean(), 0.28525, 4 * R.stderr_() + 1e-5);
+}
+
 // In the optically thin limit the fast renderer (thin table, exact
 // traversal) and the path tracer with single scattering compute the same
 // quantity; their image sums agree within 4 standard errors of the truth plus
@@ -352,6 +388,35 @@ TEST(PathTracer, SameSeedSameImageAndNoNaN) {
   EXPECT_GT(a.counters.vertices, 0u);
   in.seed = 2;
   EXPECT_NE(render_truth_cpu(in).image.pixels, a.image.pixels);
+}
+
+// A camera inside the cloud (perspective and fisheye) next to a star inside
+// dust: finite, non-negative pixels; the 1/r^2 of a collision near the star
+// is a large but finite sample.
+TEST(PathTracer, CameraInsideTheCloudStaysFinite) {
+  DensityGrid g = noise_grid(10, 1.0f, 1.0f, 61);
+  TruthInputs in;
+  in.density = &g;
+  in.bands = {TruthBand{"V", 1.0f, 0.6f, 0.6f, nullptr}};
+  in.stars = {TruthStar{{0.01f, 0.02f, 0.03f}, {1e4f}}};
+  for (Projection p : {Projection::Perspective, Projection::Fisheye}) {
+    CameraSettings cs;
+    cs.projection = p;
+    cs.position = {0.3f, -0.2f, 0.1f};
+    cs.look_at = {0, 0, 0};
+    cs.up = {0, 0, 1};
+    cs.width = cs.height = 12;
+    in.camera = make_camera(cs);
+    in.spp = 8;
+    const TruthOutput out = render_truth_cpu(in);
+    double sum = 0;
+    for (float v : out.image.pixels) {
+      EXPECT_TRUE(std::isfinite(v) && v >= 0);
+      sum += v;
+    }
+    for (float v : out.variance.pixels) EXPECT_TRUE(std::isfinite(v) && v >= 0);
+    EXPECT_GT(sum, 0.0);
+  }
 }
 
 TEST(PathTracer, RefusesBadInputs) {
