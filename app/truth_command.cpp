@@ -27,7 +27,7 @@ namespace {
 struct Options {
   std::string scene_path, out, backend = "auto", spp;
   std::vector<std::string> overrides;
-  bool demo = false, force = false, quiet = false;
+  bool demo = false, force = false, quiet = false, equiangular = false;
   std::string transmittance = "ratio";
   int width = 0, height = 0, max_orders = 0, majorant_block = 4;
   uint64_t seed = 1;
@@ -70,6 +70,7 @@ void run_truth(const Options& o) {
   in.max_orders = o.max_orders;
   in.majorant_block = o.majorant_block;
   in.exact_transmittance = o.transmittance == "exact";
+  in.equiangular = o.equiangular;
   std::unique_ptr<Progress> progress;
   if (!o.quiet && backend == Backend::Cpu) progress = std::make_unique<Progress>("truth", uint64_t(camera.height));
   in.progress = progress.get();
@@ -95,7 +96,7 @@ void run_truth(const Options& o) {
   meta.entries.push_back({"R_V", to_text(scene.dust.R_V)});
   meta.entries.push_back({"scene", scene.path});
   meta.entries.push_back({"mode", "truth spp " + std::to_string(spp) + " seed " + std::to_string(o.seed) + " " +
-                                      o.transmittance + " transmittance" +
+                                      o.transmittance + " transmittance" + (o.equiangular ? " equiangular" : "") +
                                       (o.max_orders ? " orders<=" + std::to_string(o.max_orders) : "")});
   ImageMetadata var_meta = meta;
   var_meta.units = "(L_sun pc^-2 sr^-1 x exposure)^2, variance of the pixel mean";
@@ -134,6 +135,9 @@ void add_truth_command(CLI::App& app) {
   cmd->add_option("--transmittance", o->transmittance,
                   "to the stars: ratio (residual ratio tracking) or exact (the voxel sum: no noise)")
       ->capture_default_str();
+  cmd->add_flag("--equiangular", o->equiangular,
+               "next-event estimation also from equiangular samples towards each star, combined by MIS "
+               "(bounded weights for stars inside dust)");
   cmd->add_flag("--force", o->force, "overwrite existing outputs");
   cmd->add_flag("-q,--quiet", o->quiet, "no progress bar");
   cmd->callback([o] { run_truth(*o); });

@@ -59,6 +59,7 @@ HostPathScene prepare_path_scene(const TruthInputs& in) {
   s.max_orders = in.max_orders;
   s.roulette_start = in.roulette_start;
   s.exact_transmittance = in.exact_transmittance;
+  s.equiangular = in.equiangular;
   return h;
 }
 

@@ -67,6 +67,7 @@ struct PathScene {
   int max_orders = 0;      // 0: unlimited (the truth); k > 0: orders 1..k only (tests, studies)
   int roulette_start = 3;  // collisions before Russian roulette plays
   bool exact_transmittance = false;  // NEE: exact DDA sum over voxels instead of ratio tracking
+  bool equiangular = false;  // NEE also from equiangular samples towards each star, MIS with the collisions
 };
 
 struct PathCounters {
@@ -211,34 +212,100 @@ NEBULA_HD float emission_along(const PathScene& s, int b, float scale, Vec3 orig
   return radiance;
 }
 
+// Light from `star` scattered at x towards -dir per unit sigma_sct:
+// Phi / (4 pi r^2) T(star -> x) p_HG(mu); 0 within 1e-12 voxel of the star.
+template <class Rng>
+NEBULA_HD float star_light(const PathScene& s, int b, float scale, Vec3 x, Vec3 dir, const TruthStarView& star,
+                           Rng& rng, PathCounters& c) {
+  const Vec3 d = x - star.position;  // the light's direction before scattering
+  const float r2 = dot(d, d);
+  const float near2 = 1e-24f * s.density.shape.voxel * s.density.shape.voxel;
+  if (!(r2 > near2) || !(star.power[b] > 0.0f)) return 0.0f;
+  const float mu = dot(d, -dir) / sqrtf(r2);  // after scattering it goes back along the path
+  const float t = s.exact_transmittance
+                      ? expf(-s.extinction_ratio[b] * segment_optical_depth(s.density, x, star.position))
+                      : ratio_track(s, scale, x, star.position, rng, c);
+  return star.power[b] * kInv4Pi / r2 * t * hg_phase(s.g[b], mu);
+}
+
+// Equiangular sampling of a point on the ray o + t dir, t in [t0, t1], with
+// density proportional to 1 / r^2 from a point c (Kulla & Fajardo 2012):
+// its pdf cancels the star's 1/r^2, so the weights stay bounded near a star.
+struct Equiangular {
+  float delta = 0, dist = 0, theta0 = 0, theta1 = 0, t0 = 0, t1 = 0;
+  bool ok = false;
+  NEBULA_HD Equiangular(Vec3 o, Vec3 dir, Vec3 c, float t0_, float t1_, float min_dist) : t0(t0_), t1(t1_) {
+    delta = dot(c - o, dir);
+    dist = length(c - (o + delta * dir));
+    if (!(dist > min_dist)) return;
+    theta0 = atan2f(t0 - delta, dist);
+    theta1 = atan2f(t1 - delta, dist);
+    ok = theta1 > theta0;
+  }
+  NEBULA_HD float sample(float u) const { return delta + dist * tanf(theta0 + u * (theta1 - theta0)); }
+  NEBULA_HD float pdf(float t) const {
+    if (!ok || t < t0 || t > t1) return 0.0f;
+    const float x = t - delta;
+    return dist / ((theta1 - theta0) * (dist * dist + x * x));
+  }
+};
+
 // One path of band b from `origin` along unit `dir`: its radiance estimate.
 template <class Rng>
 NEBULA_HD float trace_path(const PathScene& s, int b, Vec3 origin, Vec3 dir, Rng& rng, PathCounters& c) {
   const float a = s.albedo[b], g = s.g[b];
   const float scale = s.extinction_ratio[b] / s.density.shape.voxel;
   const bool emits = s.emission[b] != nullptr;
-  const float near2 = 1e-24f * s.density.shape.voxel * s.density.shape.voxel;
+  const GridShape& grid = s.density.shape;
+  const float min_dist = 1e-6f * grid.voxel;
   if (!emits && (s.n_stars == 0 || !(a > 0.0f))) return 0.0f;
   float weight = 1.0f, radiance = 0.0f;
   Vec3 pos = origin;
   for (int order = 0;;) {
     if (emits) radiance += weight * emission_along(s, b, scale, pos, dir);
     if (!(a > 0.0f)) break;
+    // With equiangular sampling, next-event estimation on this segment has two
+    // techniques per star, combined by the balance heuristic: a point drawn
+    // towards the star (pdf p_e) and the delta-tracking collision (pdf
+    // p_d(t) = sigma_ext(t) T(0, t)). Each contributes f / (p_e + p_d), with
+    // f = T(0, t) sigma_sct(t) star_light(t); T(0, t) by the exact voxel sum.
+    float seg0 = 0.0f, seg1 = 0.0f;
+    const bool mis = s.equiangular && clip_to_grid(grid, pos, dir, beyond_grid(grid, pos), seg0, seg1);
+    if (mis) {
+      for (int k = 0; k < s.n_stars; ++k) {
+        const Equiangular e(pos, dir, s.stars[k].position, seg0, seg1, min_dist);
+        if (!e.ok) continue;
+        const float te = e.sample(rng.next());
+        const float pe = e.pdf(te);
+        if (!(pe > 0.0f)) continue;
+        const Vec3 xe = pos + te * dir;
+        const float sigma = tau_v_at(s.density, xe) * scale;
+        if (!(sigma > 0.0f)) continue;
+        const float tr = expf(-s.extinction_ratio[b] * segment_optical_depth(s.density, pos, xe));
+        const float f = tr * a * sigma * star_light(s, b, scale, xe, dir, s.stars[k], rng, c);
+        radiance += weight * f / (pe + sigma * tr);
+      }
+    }
+    const Vec3 from = pos;
     Vec3 hit;
     if (!delta_track(s, scale, pos, dir, rng, hit, c)) break;
     pos = hit;
     ++order;
     ++c.vertices;
+    float tr_hit = 1.0f, sigma_hit = 0.0f, t_hit = 0.0f;
+    if (mis) {
+      t_hit = length(hit - from);
+      tr_hit = expf(-s.extinction_ratio[b] * segment_optical_depth(s.density, from, hit));
+      sigma_hit = tau_v_at(s.density, hit) * scale;
+    }
     for (int k = 0; k < s.n_stars; ++k) {
-      const TruthStarView& star = s.stars[k];
-      const Vec3 d = pos - star.position;  // the light's direction before scattering
-      const float r2 = dot(d, d);
-      if (!(r2 > near2) || !(star.power[b] > 0.0f)) continue;
-      const float mu = dot(d, -dir) / sqrtf(r2);  // after scattering it goes back along the path
-      const float t = s.exact_transmittance
-                          ? expf(-s.extinction_ratio[b] * segment_optical_depth(s.density, pos, star.position))
-                          : ratio_track(s, scale, pos, star.position, rng, c);
-      radiance += weight * a * star.power[b] * kInv4Pi / r2 * t * hg_phase(g, mu);
+      const float light = star_light(s, b, scale, pos, dir, s.stars[k], rng, c);
+      if (!(light > 0.0f)) continue;
+      float pe = 0.0f;
+      if (mis) pe = Equiangular(from, dir, s.stars[k].position, seg0, seg1, min_dist).pdf(t_hit);
+      // Without the other technique (pe = 0) this is weight x a x light: the
+      // collision estimator, sigma_sct T / (sigma_ext T).
+      radiance += pe > 0.0f ? weight * tr_hit * a * sigma_hit * light / (sigma_hit * tr_hit + pe) : weight * a * light;
     }
     if (s.max_orders > 0 && order >= s.max_orders) break;
     if (order >= kTruthMaxOrders) {

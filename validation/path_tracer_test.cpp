@@ -163,7 +163,7 @@ TEST(PathTracer, PureExtinctionSlabIsExactAndNoiseless) {
 // f(b, zmax), and changes each of the two attenuating paths by up to sqrt(3) l
 // (k sqrt(3) l relative each). Nothing else is approximated: the tracer
 // evaluates 1/r^2 and the angle where it collides.
-TEST(PathTracer, ThinSphereSingleScatteringProfile) {
+void expect_thin_sphere_profile(bool equiangular) {
   const int n = 64, pixels = 48, spp = 512;
   const float half = 1.0f, radius = 0.8f, kappa = 0.1f, albedo = 0.6f, g = 0.6f, power = 1000.0f;
   DensityGrid grid = cube(n, half);
@@ -176,6 +176,7 @@ TEST(PathTracer, ThinSphereSingleScatteringProfile) {
   in.camera = telescope(pixels, 2.0f);
   in.spp = spp;
   in.max_orders = 1;
+  in.equiangular = equiangular;
   const TruthOutput out = render_truth_cpu(in);
   const double sigma_s = albedo * kappa;
   // The integrand at impact parameter b and depth z.
@@ -218,13 +219,43 @@ TEST(PathTracer, ThinSphereSingleScatteringProfile) {
     expected /= count;
     bias /= count;
     const double se = std::sqrt(var) / count;
-    std::printf("b in [%.2f, %.2f): truth %.5g +- %.2g, line integral %.5g, bias bound %.2g\n", b0, b0 + 0.1, got,
-                se, expected, bias);
+    std::printf("%s b in [%.2f, %.2f): truth %.5g +- %.2g, line integral %.5g, bias bound %.2g\n",
+                equiangular ? "equiangular" : "collisions", b0, b0 + 0.1, got, se, expected, bias);
     EXPECT_NEAR(got, expected, 4 * se + bias);
     ++checked;
   }
   EXPECT_EQ(checked, 6);
   EXPECT_EQ(out.counters.capped, 0u);
+}
+
+TEST(PathTracer, ThinSphereSingleScatteringProfile) { expect_thin_sphere_profile(false); }
+TEST(PathTracer, ThinSphereSingleScatteringProfileEquiangular) { expect_thin_sphere_profile(true); }
+
+// Next-event estimation with and without equiangular samples (MIS): the same
+// image within the combined noise, all orders, a star inside the dust; and
+// equiangular sampling is the less noisy of the two there.
+TEST(PathTracer, EquiangularMisAgreesAndHelpsWithAStarInDust) {
+  DensityGrid g = noise_grid(12, 1.0f, 0.5f, 71);
+  TruthInputs in;
+  in.density = &g;
+  in.bands = {TruthBand{"V", 1.0f, 0.8f, 0.6f, nullptr}};
+  in.stars = {TruthStar{{0.05f, 0.1f, -0.02f}, {100.0f}}, TruthStar{{0.0f, 3.0f, 0.0f}, {100.0f}}};
+  in.camera = telescope(16, 2.0f);
+  in.spp = 64;
+  const TruthOutput plain = render_truth_cpu(in);
+  in.equiangular = true;
+  in.seed = 9;
+  const TruthOutput mis = render_truth_cpu(in);
+  const BandComparison c = compare_images(mis.image, plain.image, &mis.variance, &plain.variance).bands[0];
+  double var_plain = 0, var_mis = 0;
+  for (size_t i = 0; i < plain.variance.pixels.size(); ++i) {
+    var_plain += plain.variance.pixels[i];
+    var_mis += mis.variance.pixels[i];
+  }
+  std::printf("equiangular vs collisions: bias %+.4f +- %.4f, mean z^2 %.3f; summed variance %.3g vs %.3g\n", c.bias,
+              c.bias_stderr, c.mean_z2, var_mis, var_plain);
+  EXPECT_NEAR(c.bias, 0.0, 4 * c.bias_stderr);
+  EXPECT_LT(var_mis, var_plain);
 }
 
 // van de Hulst's slab (a = 0.9, g = 0.75, tau = 2; the tabulator's reference

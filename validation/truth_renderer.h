@@ -42,6 +42,7 @@ struct TruthInputs {
   int roulette_start = 3;
   int majorant_block = 4;  // voxels per majorant block edge
   bool exact_transmittance = false;  // NEE transmittance by the exact voxel sum (no noise) instead of ratio tracking
+  bool equiangular = false;  // NEE also from equiangular samples towards each star (MIS): stars inside dust
   Progress* progress = nullptr;  // advanced in image rows (CPU); may be null
 };
 
