@@ -14,7 +14,7 @@
 namespace nebula {
 namespace {
 
-TEST(TruthGpu, CpuAndCudaAgreeWithinTheirNoise) {
+void expect_cpu_and_cuda_agree(bool equiangular) {
   std::string why;
   if (!gpu_available(&why)) GTEST_SKIP() << "no usable GPU: " << why;
   DensityGrid g = testing::cube(24, 1.0f);
@@ -39,10 +39,11 @@ TEST(TruthGpu, CpuAndCudaAgreeWithinTheirNoise) {
   cs.height = 48;
   in.camera = make_camera(cs);
   in.spp = 64;
+  in.equiangular = equiangular;
   const TruthOutput cpu = render_truth_cpu(in), gpu = render_truth_cuda(in);
   const Comparison c = compare_images(gpu.image, cpu.image, &gpu.variance, &cpu.variance);
   for (const BandComparison& r : c.bands) {
-    std::printf("band %s: rel L2 %.3g, noise %.3g, mean z^2 %.3g, beyond 4 sigma %.3g\n", r.band.c_str(), r.rel_l2,
+    std::printf("%s band %s: rel L2 %.3g, noise %.3g, mean z^2 %.3g, beyond 4 sigma %.3g\n", equiangular ? "equiangular" : "collisions", r.band.c_str(), r.rel_l2,
                 r.noise_rel_l2, r.mean_z2, r.beyond_4sigma);
     EXPECT_GT(r.signal_pixels, 1000u);
     EXPECT_TRUE(r.within_noise);
@@ -53,6 +54,9 @@ TEST(TruthGpu, CpuAndCudaAgreeWithinTheirNoise) {
   std::printf("vertices: cpu %llu, gpu %llu\n", (unsigned long long)cpu.counters.vertices,
               (unsigned long long)gpu.counters.vertices);
 }
+
+TEST(TruthGpu, CpuAndCudaAgreeWithinTheirNoise) { expect_cpu_and_cuda_agree(false); }
+TEST(TruthGpu, CpuAndCudaAgreeWithinTheirNoiseEquiangular) { expect_cpu_and_cuda_agree(true); }
 
 }  // namespace
 }  // namespace nebula
