@@ -227,6 +227,7 @@ void add_bench_command(CLI::App& app) {
     std::string backends = "auto";
     int size = 256, width = 1920, height = 1080, spp = 16, repeats = 3;
     std::string transmittance = "both";
+    bool equiangular = false;
   };
   auto t = std::make_shared<TruthOptions>();
   truth->add_option("--backend", t->backends, "cpu, cuda, both or auto")->capture_default_str();
@@ -237,6 +238,7 @@ void add_bench_command(CLI::App& app) {
   truth->add_option("--repeats", t->repeats, "timed runs after the warm-up")->capture_default_str();
   truth->add_option("--transmittance", t->transmittance, "next-event transmittance: ratio, exact or both")
       ->capture_default_str();
+  truth->add_flag("--equiangular", t->equiangular, "with equiangular next-event estimation (MIS)");
   truth->callback([t] {
     if (t->transmittance != "ratio" && t->transmittance != "exact" && t->transmittance != "both")
       throw Error("--transmittance: expected ratio, exact or both, got '" + t->transmittance + "'");
@@ -261,10 +263,13 @@ void add_bench_command(CLI::App& app) {
         // The CPU traces a 1/10 x 1/10 image at 2 spp (same rates per path, minutes less).
         const bool cpu = backend == Backend::Cpu;
         const int w = cpu ? std::max(1, t->width / 10) : t->width, h = cpu ? std::max(1, t->height / 10) : t->height;
-        const TruthBenchRow row = bench_truth(backend, t->size, w, h, cpu ? 2 : t->spp, cpu ? 1 : t->repeats, exact);
+        const TruthBenchRow row = bench_truth(backend, t->size, w, h, cpu ? 2 : t->spp, cpu ? 1 : t->repeats, exact,
+                                              t->equiangular);
         // spp/s at 1920x1080: the same paths per second spread over 1920x1080 pixels.
         std::printf("| %s | %s | %dx%d | %d^3 | %d | %.4f | %.3g | %.3g | %.3g | %.3g | %.2f |\n", row.backend.c_str(),
-                    exact ? "exact" : "ratio", row.width, row.height, row.size, row.spp, row.median_seconds,
+                    exact ? (t->equiangular ? "exact+equiangular" : "exact")
+                          : (t->equiangular ? "ratio+equiangular" : "ratio"),
+                    row.width, row.height, row.size, row.spp, row.median_seconds,
                     row.vertices_per_second, row.paths_per_second, row.spp_per_second,
                     row.spp_per_second * double(row.width) * row.height / (1920.0 * 1080.0), row.vertices_per_path);
         std::fflush(stdout);

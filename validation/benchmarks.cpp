@@ -169,7 +169,7 @@ std::vector<RenderBenchRow> bench_render(Backend backend, int size, int width, i
 namespace nebula {
 
 TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int spp, int repeats,
-                          bool exact_transmittance) {
+                          bool exact_transmittance, bool equiangular) {
   ProceduralParams pp;
   pp.n = size;
   const DensityGrid grid = procedural_nebula(pp);
@@ -189,6 +189,7 @@ TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int 
   in.camera = make_camera(cs);
   in.spp = spp;
   in.exact_transmittance = exact_transmittance;
+  in.equiangular = equiangular;
   TruthOutput out = render_truth(in, backend);  // warm-up
   std::vector<double> times;
   for (int i = 0; i < repeats; ++i) {

@@ -84,6 +84,6 @@ struct TruthBenchRow {
 // a = g = 0.6; one warm-up, then `repeats` timed runs at `spp`. Next-event
 // transmittance by ratio tracking, or by the exact voxel sum.
 TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int spp, int repeats,
-                          bool exact_transmittance = false);
+                          bool exact_transmittance = false, bool equiangular = false);
 
 }  // namespace nebula
