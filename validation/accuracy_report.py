@@ -65,6 +65,7 @@ class Runner:
         self.work = os.path.abspath(args.work)
         self.backend = args.backend
         self.transmittance = args.transmittance
+        self.equiangular = args.equiangular
         os.makedirs(self.work, exist_ok=True)
         self.env = dict(os.environ, NEBULA_CACHE_DIR=os.path.join(self.work, "cache"))
         help_text = self.run(["render", "--help"])
@@ -78,7 +79,8 @@ class Runner:
 
     def truth(self, scene, spp, seed, out, extra=()):
         text = self.run(["truth", scene, "--spp", str(spp), "--seed", str(seed), "--backend", self.backend, "-q",
-                         "--transmittance", self.transmittance, "--force", "-o", out] + list(extra))
+                         "--transmittance", self.transmittance, "--force", "-o", out] +
+                        (["--equiangular"] if self.equiangular else []) + list(extra))
         return float(re.search(r"tracing ([0-9.eE+-]+) s", text).group(1))
 
     def render(self, scene, out, extra):
@@ -217,7 +219,8 @@ def write_markdown(rows, args, r, table_times, path, elapsed):
     out.append("# Accuracy: the fast renderer and the path tracer against the ground truth\n")
     out.append(f"Regenerate: `/usr/bin/python3 validation/accuracy_report.py --nebula build/bin/nebula` "
                f"(this run: {elapsed / 60:.1f} min on {machine}, backend {args.backend}, truth with "
-               f"{args.transmittance} transmittance; "
+               f"{args.transmittance} transmittance and "
+               f"{'equiangular (MIS)' if args.equiangular else 'collision-only'} next-event estimation; "
                f"images {args.note}). The physics of the truth and how to read these numbers: "
                "[docs/truth.md](truth.md).\n")
     out.append("Columns, per image against the reference (mean over bands B, V, R; `nebula compare`): "
@@ -283,6 +286,8 @@ def main():
     p.add_argument("--transmittance", default="exact",
                    help="the truth's next-event transmittance: exact (voxel sum; 2x faster on 32^3 grids at equal "
                         "noise, measured) or ratio")
+    p.add_argument("--equiangular", action="store_true",
+                   help="the truth with equiangular next-event estimation (MIS; for stars inside dust)")
     p.add_argument("--scenes", nargs="*", default=SCENES)
     p.add_argument("--ref-spp", type=int, default=1024)
     p.add_argument("--truth-spp", type=int, nargs="*", default=[4, 16, 64, 256])
