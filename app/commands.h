@@ -10,5 +10,7 @@ void add_slab_command(CLI::App& app);
 void add_validate_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_render_command(CLI::App& app);
+void add_truth_command(CLI::App& app);
+void add_compare_command(CLI::App& app);
 
 }  // namespace nebula::app

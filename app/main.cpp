@@ -13,6 +13,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "nebula 0.1.0");
   nebula::app::add_render_command(app);
+  nebula::app::add_truth_command(app);
+  nebula::app::add_compare_command(app);
   nebula::app::add_tabulate_command(app);
   nebula::app::add_table_command(app);
   nebula::app::add_slab_command(app);

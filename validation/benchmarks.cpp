@@ -9,6 +9,7 @@
 #include "raycast/renderer.h"
 #include "scene/density_sources.h"
 #include "tables/scattering_table.h"
+#include "validation/truth_renderer.h"
 
 namespace nebula {
 namespace {
@@ -206,6 +207,53 @@ PyramidBench bench_pyramid(Backend backend, int size, int width, int height, int
   for (int j = 0; j <= levels; ++j) out.levels[j].render_seconds = median_of(render_times[j]);
   out.combine_seconds = median_of(combine_times);
   return out;
+}
+
+}  // namespace nebula
+
+namespace nebula {
+
+TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int spp, int repeats,
+                          bool exact_transmittance, bool equiangular) {
+  ProceduralParams pp;
+  pp.n = size;
+  const DensityGrid grid = procedural_nebula(pp);
+  const Vec3 centre = procedural_star_position(pp);
+  CameraSettings cs;
+  cs.position = centre + Vec3{0.4f, -3.2f, 1.1f};
+  cs.look_at = centre;
+  cs.up = {0, 0, 1};
+  cs.fov_deg = 45;
+  cs.width = width;
+  cs.height = height;
+  TruthInputs in;
+  in.density = &grid;
+  const float ratios[3] = {1.2f, 1.0f, 0.85f};
+  for (int b = 0; b < 3; ++b) in.bands.push_back(TruthBand{std::string(1, "BVR"[b]), ratios[b], 0.6f, 0.6f, nullptr});
+  in.stars = {TruthStar{centre, {1e3f, 1e3f, 1e3f}}};
+  in.camera = make_camera(cs);
+  in.spp = spp;
+  in.exact_transmittance = exact_transmittance;
+  in.equiangular = equiangular;
+  TruthOutput out = render_truth(in, backend);  // warm-up
+  std::vector<double> times;
+  for (int i = 0; i < repeats; ++i) {
+    in.seed = 2 + i;
+    out = render_truth(in, backend);
+    times.push_back(out.seconds);
+  }
+  TruthBenchRow row;
+  row.backend = to_string(backend);
+  row.width = width;
+  row.height = height;
+  row.size = size;
+  row.spp = spp;
+  row.median_seconds = median_of(times);
+  row.vertices_per_second = out.counters.vertices / row.median_seconds;
+  row.paths_per_second = out.paths / row.median_seconds;
+  row.spp_per_second = spp / row.median_seconds;
+  row.vertices_per_path = out.paths ? double(out.counters.vertices) / out.paths : 0;
+  return row;
 }
 
 }  // namespace nebula

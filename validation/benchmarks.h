@@ -79,3 +79,24 @@ struct PyramidBench {
 PyramidBench bench_pyramid(Backend backend, int size, int width, int height, int levels, int repeats);
 
 }  // namespace nebula
+
+namespace nebula {
+
+struct TruthBenchRow {
+  std::string backend;
+  int width = 0, height = 0, size = 0, spp = 0;
+  double median_seconds = 0;      // tracing only (CUDA events on the GPU)
+  double vertices_per_second = 0; // real collisions (each with next-event estimation to the star)
+  double paths_per_second = 0;    // one path per pixel, sample and band
+  double spp_per_second = 0;      // samples per pixel (all three bands) per second at width x height
+  double vertices_per_path = 0;
+};
+
+// The path tracer on the procedural nebula (as bench_render: default
+// parameters at size^3 voxels, its star, the same camera), bands B, V, R with
+// a = g = 0.6; one warm-up, then `repeats` timed runs at `spp`. Next-event
+// transmittance by ratio tracking, or by the exact voxel sum.
+TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int spp, int repeats,
+                          bool exact_transmittance = false, bool equiangular = false);
+
+}  // namespace nebula

@@ -1,0 +1,337 @@
+#!/usr/bin/env python3
+"""Speed against error of the fast renderer and of the path tracer (issue 5).
+
+One command regenerates everything (results, plots, docs/accuracy.md):
+
+    /usr/bin/python3 validation/accuracy_report.py --nebula build/bin/nebula
+
+(any python3 with numpy, matplotlib and h5py). For each scene of the standard
+set (validation/scenes/*.toml) it renders a reference with `nebula truth`,
+then runs `nebula render` as each knob varies (photons per table row, the
+table's tau and mu resolution, the smooth mode's step, pyramid levels when
+`nebula render` has `--levels`) and `nebula truth` at growing spp, compares
+each image to the reference with `nebula compare --json`, and writes
+docs/accuracy.md and docs/images/accuracy_*.png. Times are what the commands
+report: the fast renderer's bake + march (tables are generated once and
+cached; their cost is listed apart), the path tracer's tracing time.
+"""
+import argparse
+import json
+import os
+import platform
+import re
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCENES = ["thin_nebula", "thick_nebula", "layer_front", "layer_behind", "wedge"]
+
+
+def write_densities(folder):
+    """The layer and wedge grids of validation/scenes (32^3 over 2 pc, deterministic)."""
+    n, voxel = 32, 2.0 / 32
+    rng = np.random.default_rng(5)
+    path = os.path.join(folder, "layers.h5")
+    if not os.path.exists(path):
+        with h5py.File(path + ".tmp", "w") as f:
+            for y0 in (12, 20):
+                g = np.zeros((n, n, n), np.float32)  # [z][y][x]
+                g[:, y0:y0 + 4, :] = 0.25 * (1 + 0.3 * rng.uniform(-1, 1, (n, 4, n)))
+                d = f.create_dataset(f"layer_y{y0}", data=g)
+                d.attrs["voxel_size"] = voxel
+        os.replace(path + ".tmp", path)
+    path = os.path.join(folder, "wedge.h5")
+    if not os.path.exists(path):
+        z, y, x = np.meshgrid(np.arange(n), np.arange(n), np.arange(n), indexing="ij")
+        g = np.full((n, n, n), 0.02, np.float32)
+        g[x >= 14 + 0.6 * np.abs(y - 15.5)] = 1.5  # sharp slanted faces, apex towards the star
+        with h5py.File(path + ".tmp", "w") as f:
+            d = f.create_dataset("tau_v", data=g)
+            d.attrs["voxel_size"] = voxel
+        os.replace(path + ".tmp", path)
+
+
+class Runner:
+    def __init__(self, args):
+        self.nebula = os.path.abspath(args.nebula)
+        self.work = os.path.abspath(args.work)
+        self.backend = args.backend
+        self.transmittance = args.transmittance
+        self.equiangular = args.equiangular
+        os.makedirs(self.work, exist_ok=True)
+        self.env = dict(os.environ, NEBULA_CACHE_DIR=os.path.join(self.work, "cache"))
+        help_text = self.run(["render", "--help"])
+        self.has_levels = "--levels" in help_text
+
+    def run(self, argv):
+        r = subprocess.run([self.nebula] + argv, capture_output=True, text=True, env=self.env, cwd=self.work)
+        if r.returncode != 0:
+            raise SystemExit(f"nebula {' '.join(argv)} failed ({r.returncode}): {r.stderr.strip()}")
+        return r.stdout
+
+    def truth(self, scene, spp, seed, out, extra=()):
+        text = self.run(["truth", scene, "--spp", str(spp), "--seed", str(seed), "--backend", self.backend, "-q",
+                         "--transmittance", self.transmittance, "--force", "-o", out] +
+                        (["--equiangular"] if self.equiangular else []) + list(extra))
+        return float(re.search(r"tracing ([0-9.eE+-]+) s", text).group(1))
+
+    def render(self, scene, out, extra):
+        text = self.run(["render", scene, "--backend", self.backend, "-q", "--force", "-o", out] + extra)
+        bake = re.search(r"bake: .*?, ([0-9.eE+-]+) s", text)
+        march = float(re.search(r"render: ([0-9.eE+-]+) s marching", text).group(1))
+        return march + (float(bake.group(1)) if bake else 0.0)
+
+    def compare(self, a, b):
+        c = json.loads(self.run(["compare", a, b, "--json"]))
+        return c["bands"]
+
+    def tabulate(self, out, photons, tau_bins, mu_bins):
+        """Makes the table once; its generation time is kept beside it (out.seconds)."""
+        if os.path.exists(out) and os.path.exists(out + ".seconds"):
+            with open(out + ".seconds") as f:
+                return float(f.read())
+        t0 = time.time()
+        self.run(["tabulate", "--photons", str(photons), "--tau-bins", str(tau_bins), "--mu-bins", str(mu_bins),
+                  "--binning", "uniform-theta", "--backend", self.backend, "-q", "--force", "-o", out])
+        seconds = time.time() - t0
+        with open(out + ".seconds", "w") as f:
+            f.write(f"{seconds:.3f}\n")
+        return seconds
+
+
+def summarise(bands):
+    """Mean over bands of the metrics the report uses."""
+    keys = ["rel_l1", "rel_l2", "worst_1pct", "bias", "noise_rel_l2", "rel_l2_excess"]
+    out = {k: float(np.mean([b[k] for b in bands])) for k in keys}
+    # Bands are traced on independent random streams: the mean's error adds in quadrature.
+    out["bias_stderr"] = float(np.sqrt(np.sum([b["bias_stderr"] ** 2 for b in bands])) / len(bands))
+    return out
+
+
+def study(r, name, args, rows, notes):
+    scene = os.path.join(ROOT, "validation", "scenes", name + ".toml")
+    d = os.path.join(r.work, name)
+    os.makedirs(d, exist_ok=True)
+    ref = os.path.join(d, "truth_ref.h5")
+    t_ref = r.truth(scene, args.ref_spp, 1, ref)
+    rows.append(dict(scene=name, method="truth (reference)", knob="spp", value=args.ref_spp, seconds=t_ref,
+                     **summarise(r.compare(ref, ref))))
+    # Scattering orders: single scattering only (and up to 2), against the full truth: how much of the image
+    # is light scattered more than once.
+    for orders in (1, 2):
+        out = os.path.join(d, f"truth_orders_{orders}.h5")
+        t = r.truth(scene, args.orders_spp, 50 + orders, out, ["--max-orders", str(orders)])
+        rows.append(dict(scene=name, method="truth orders", knob="max orders", value=orders, seconds=t,
+                         **summarise(r.compare(out, ref))))
+    for k, spp in enumerate(args.truth_spp):
+        out = os.path.join(d, f"truth_{spp}.h5")
+        t = r.truth(scene, spp, 100 + k, out)
+        rows.append(dict(scene=name, method="truth", knob="spp", value=spp, seconds=t, **summarise(r.compare(out, ref))))
+    for photons in args.photons:
+        out = os.path.join(d, f"fast_photons_{photons}.h5")
+        t = r.render(scene, out, ["--table-photons", str(photons)])
+        rows.append(dict(scene=name, method="fast", knob="table photons/row", value=photons, seconds=t,
+                         **summarise(r.compare(out, ref))))
+    for step in args.steps:
+        out = os.path.join(d, f"fast_smooth_{step}.h5")
+        t = r.render(scene, out, ["--table-photons", str(args.default_photons), "--smooth", str(step)])
+        rows.append(dict(scene=name, method="fast smooth", knob="step (voxels)", value=step, seconds=t,
+                         **summarise(r.compare(out, ref))))
+    for tau_bins, mu_bins in args.resolutions:
+        table = os.path.join(r.work, f"table_{tau_bins}x{mu_bins}.h5")
+        sets = []
+        for band in ("B", "V", "R"):
+            sets += ["--set", f"dust.tables.{band}={table}"]
+        out = os.path.join(d, f"fast_table_{tau_bins}x{mu_bins}.h5")
+        t = r.render(scene, out, sets)
+        rows.append(dict(scene=name, method="fast table", knob="tau x mu bins", value=f"{tau_bins}x{mu_bins}",
+                         seconds=t, **summarise(r.compare(out, ref))))
+    if r.has_levels:
+        for levels in args.levels:
+            out = os.path.join(d, f"fast_levels_{levels}.h5")
+            t = r.render(scene, out, ["--table-photons", str(args.default_photons), "--levels", str(levels)])
+            rows.append(dict(scene=name, method="fast pyramid", knob="levels", value=levels, seconds=t,
+                             **summarise(r.compare(out, ref))))
+
+
+def plot(rows, images):
+    os.makedirs(images, exist_ok=True)
+    markers = {"truth": "o-", "fast": "s", "fast smooth": "^", "fast table": "D", "fast pyramid": "v"}
+    # (truth orders rows are a diagnostic of the scene, not a method: left out of this plot)
+    scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    fig, axes = plt.subplots(1, len(scenes), figsize=(4 * len(scenes), 3.8), sharey=True)
+    for ax, scene in zip(np.atleast_1d(axes), scenes):
+        for method, style in markers.items():
+            sel = [r for r in rows if r["scene"] == scene and r["method"] == method]
+            if not sel:
+                continue
+            # The error beyond the reference's noise; the truth's own error is its noise.
+            err = [max(r["rel_l2_excess"], 1e-4) if method != "truth" else r["rel_l2"] for r in sel]
+            ax.loglog([r["seconds"] for r in sel], err, style, label=method, alpha=0.8)
+        ref = [r for r in rows if r["scene"] == scene and r["method"] == "truth (reference)"][0]
+        ax.axhline(ref["noise_rel_l2"] / np.sqrt(2), color="grey", lw=0.8, ls=":")
+        ax.set_title(scene)
+        ax.set_xlabel("time (s, CPU)")
+        ax.grid(True, which="both", alpha=0.3)
+    np.atleast_1d(axes)[0].set_ylabel("relative L2 error against the truth")
+    np.atleast_1d(axes)[0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(images, "accuracy_time_vs_error.png"), dpi=110)
+    plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(5, 3.8))
+    for scene in scenes:
+        sel = [r for r in rows if r["scene"] == scene and r["method"] == "truth"]
+        ax.loglog([r["value"] for r in sel], [r["rel_l2"] for r in sel], "o-", label=scene)
+    spp = np.array([min(r["value"] for r in rows if r["method"] == "truth"),
+                    max(r["value"] for r in rows if r["method"] == "truth")], float)
+    ax.loglog(spp, 0.5 * (spp / spp[0]) ** -0.5, "k--", lw=0.8, label="spp^-1/2")
+    ax.set_xlabel("samples per pixel")
+    ax.set_ylabel("relative L2 error against the reference")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(images, "accuracy_truth_convergence.png"), dpi=110)
+    plt.close(fig)
+
+
+def fmt(v):
+    return f"{v:.3g}" if isinstance(v, float) else str(v)
+
+
+# What the numbers above mean; kept with the script so that a rerun keeps it (revise it when they change).
+FINDINGS = open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "accuracy_findings.md")).read() \
+    if os.path.exists(os.path.join(os.path.dirname(os.path.abspath(__file__)), "accuracy_findings.md")) else ""
+
+
+def write_markdown(rows, args, r, table_times, path, elapsed):
+    machine = args.machine or f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores"
+    out = []
+    out.append("<!-- Generated by validation/accuracy_report.py; edit the script, not this table. -->")
+    out.append("# Accuracy: the fast renderer and the path tracer against the ground truth\n")
+    out.append(f"Regenerate: `/usr/bin/python3 validation/accuracy_report.py --nebula build/bin/nebula` "
+               f"(this run: {elapsed / 60:.1f} min on {machine}, backend {args.backend}, truth with "
+               f"{args.transmittance} transmittance and "
+               f"{'equiangular (MIS)' if args.equiangular else 'collision-only'} next-event estimation; "
+               f"images {args.note}). The physics of the truth and how to read these numbers: "
+               "[docs/truth.md](truth.md).\n")
+    out.append("Columns, per image against the reference (mean over bands B, V, R; `nebula compare`): "
+               "**rel L1**, **rel L2** over pixels with signal (reference above 10⁻³ of its peak); "
+               "**worst 1%**: 99th percentile of the per-pixel relative error; **bias**: Σ(A−B)/ΣB; "
+               "**noise**: the relative L2 the noise of both images alone gives; **excess**: the L2 error beyond "
+               "that noise, √max(0, Σ(A−B)² − Σvar)/√ΣB², the fast method's own error with the reference's "
+               "noise taken out. Times: fast = bake + march (tables cached; generation times below), "
+               "truth = tracing.\n")
+    out.append("![time against error](images/accuracy_time_vs_error.png)\n")
+    out.append("Dotted line: the reference's own noise level (relative L2). Below it an error cannot be "
+               "resolved; `excess` is clamped at 10⁻⁴ in the plot.\n")
+    out.append("![truth convergence](images/accuracy_truth_convergence.png)\n")
+    if not r.has_levels:
+        out.append("*Pyramid levels: not measured. This build's `nebula render` has no `--levels` option yet "
+                   "(another branch adds it); the script measures it automatically once it exists.*\n")
+    out.append("Table generation (CPU, one-off, cached by the renderer): " +
+               ", ".join(f"{k}: {v:.1f} s" for k, v in table_times.items()) + ".\n")
+    out.append("## Where the table method is biased, measured\n")
+    out.append("The fast renderer at its defaults (exact traversal, tables of "
+               f"{args.default_photons:g} photons per row, uniform-θ, no pyramid) against the truth; bias = "
+               "Σ(fast − truth)/Σtruth with its standard error from the truth's variance image (mean over bands), "
+               "and the L2 error beyond the truth's noise:\n")
+    out.append("| scene | bias | ± | excess rel L2 | worst 1% | truth noise (rel L2) | single scattering "
+               "/ truth | fast / single scattering |")
+    out.append("|---|---|---|---|---|---|---|---|")
+    for x in rows:
+        if x["method"] == "fast" and x["value"] == args.default_photons:
+            ref = [y for y in rows if y["scene"] == x["scene"] and y["method"] == "truth (reference)"][0]
+            ss = [y for y in rows if y["scene"] == x["scene"] and y["method"] == "truth orders" and y["value"] == 1]
+            ss_text = "—"
+            if ss:
+                # Sums over the reference's signal pixels: sum(ss)/sum(truth) = 1 + bias_ss.
+                ss_text = (f"{1 + ss[0]['bias']:.3f} | {(1 + x['bias']) / (1 + ss[0]['bias']):.3f}")
+            else:
+                ss_text = "— | —"
+            out.append(f"| {x['scene']} | {100 * x['bias']:+.1f}% | {100 * x['bias_stderr']:.1f}% | "
+                       f"{x['rel_l2_excess']:.3g} | {x['worst_1pct']:.3g} | {ref['noise_rel_l2'] / np.sqrt(2):.3g} | "
+                       f"{ss_text} |")
+    out.append("")
+    out.append(FINDINGS)
+    for scene in dict.fromkeys(x["scene"] for x in rows):
+        out.append(f"## {scene}\n")
+        out.append("| method | knob | value | time s | rel L1 | rel L2 | worst 1% | bias | noise | excess |")
+        out.append("|---|---|---|---|---|---|---|---|---|---|")
+        for x in rows:
+            if x["scene"] != scene:
+                continue
+            out.append(f"| {x['method']} | {x['knob']} | {x['value']} | {x['seconds']:.3g} | {x['rel_l1']:.3g} | "
+                       f"{x['rel_l2']:.3g} | {x['worst_1pct']:.3g} | {x['bias']:+.3g} | {x['noise_rel_l2']:.3g} | "
+                       f"{x['rel_l2_excess']:.3g} |")
+        out.append("")
+    with open(path + ".tmp", "w") as f:
+        f.write("\n".join(out) + "\n")
+    os.replace(path + ".tmp", path)
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--nebula", default=os.path.join(ROOT, "build", "bin", "nebula"))
+    p.add_argument("--work", default=os.path.join(ROOT, "build", "accuracy"))
+    p.add_argument("--backend", default="cpu")
+    p.add_argument("--transmittance", default="exact",
+                   help="the truth's next-event transmittance: exact (voxel sum; 2x faster on 32^3 grids at equal "
+                        "noise, measured) or ratio")
+    p.add_argument("--equiangular", action="store_true",
+                   help="the truth with equiangular next-event estimation (MIS; for stars inside dust)")
+    p.add_argument("--scenes", nargs="*", default=SCENES)
+    p.add_argument("--ref-spp", type=int, default=1024)
+    p.add_argument("--truth-spp", type=int, nargs="*", default=[4, 16, 64, 256])
+    p.add_argument("--orders-spp", type=int, default=256, help="spp of the single- and double-scattering runs")
+    p.add_argument("--photons", type=int, nargs="*", default=[1000, 3000, 10000, 30000])
+    p.add_argument("--default-photons", type=int, default=30000)
+    p.add_argument("--steps", type=float, nargs="*", default=[1.0, 0.5, 0.25])
+    p.add_argument("--resolutions", nargs="*", default=["100x18", "100x72", "1000x18", "1000x72"])
+    p.add_argument("--table-photons-res", type=int, default=10000, help="photons per row of the resolution tables")
+    p.add_argument("--levels", type=int, nargs="*", default=[1, 2, 3])
+    p.add_argument("--machine", default="", help="how the report names the machine")
+    p.add_argument("--note", default="64x64, grids 32^3")
+    p.add_argument("--docs", default=os.path.join(ROOT, "docs"))
+    p.add_argument("--from-json", default="", help="rewrite the plots and the page from a run's results.json")
+    args = p.parse_args()
+    args.resolutions = [tuple(int(v) for v in s.split("x")) for s in args.resolutions]
+    start = time.time()
+    if args.from_json:
+        # Only the plots and the page, from a finished run's results.
+        with open(args.from_json) as f:
+            saved = json.load(f)
+        r = argparse.Namespace(has_levels=saved["has_levels"])
+        plot(saved["rows"], os.path.join(args.docs, "images"))
+        write_markdown(saved["rows"], args, r, saved["table_times"], os.path.join(args.docs, "accuracy.md"),
+                       saved["elapsed"])
+        return 0
+    write_densities(os.path.join(ROOT, "validation", "scenes"))
+    r = Runner(args)
+    table_times = {}
+    for tau_bins, mu_bins in args.resolutions:
+        out = os.path.join(r.work, f"table_{tau_bins}x{mu_bins}.h5")
+        table_times[f"{tau_bins}x{mu_bins} at {args.table_photons_res:g} photons/row"] = r.tabulate(
+            out, args.table_photons_res, tau_bins, mu_bins)
+    rows = []
+    for name in args.scenes:
+        print(f"{name} ...", flush=True)
+        study(r, name, args, rows, None)
+    with open(os.path.join(r.work, "results.json"), "w") as f:
+        json.dump(dict(rows=rows, table_times=table_times, has_levels=r.has_levels, elapsed=time.time() - start), f,
+                  indent=1)
+    plot(rows, os.path.join(args.docs, "images"))
+    write_markdown(rows, args, r, table_times, os.path.join(args.docs, "accuracy.md"), time.time() - start)
+    print(f"wrote {os.path.join(args.docs, 'accuracy.md')} ({(time.time() - start) / 60:.1f} min)")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,355 @@
+#pragma once
+// The ground truth (DESIGN.md section 3, "Ground truth"; docs/accuracy.md):
+// an unbiased volumetric path tracer on exactly the scene the fast renderer
+// sees. Written once for host and device; path_tracer.cpp launches it with
+// TBB, path_tracer_cuda.cu with one CUDA thread per pixel.
+//
+// The medium is piecewise constant per voxel: in band b,
+// sigma_ext = tau_v (A_b/A_V) / l, sigma_sct = a_b sigma_ext, HG(g_b) phase.
+// Stars are isotropic point sources of band power Phi_b; emission j (the
+// radiance a ray gains crossing one voxel edge) is an isotropic emission
+// coefficient j / l per unit length. Each band is traced on its own paths.
+//
+// Estimators, all unbiased (no step size, no clamping of contributions):
+// * free flights: delta tracking against the majorant grid (majorant_grid.h),
+//   null collisions where the block's bound exceeds the voxel's sigma_ext;
+// * at a real collision the path's weight is multiplied by the albedo (no
+//   absorption sampling), next-event estimation to every star with residual
+//   ratio tracking for the transmittance (control = the block's minimum,
+//   tentative points at the block's max - min: a uniform block is crossed
+//   exactly, with no tentative point at all), then an HG direction;
+// * emission: at every path vertex (the camera included) the exact integral
+//   of T(t) j/l along the whole ray to the grid's edge, voxel by voxel (the
+//   medium is piecewise constant, so this is a closed form); the scattered
+//   part of the radiance is what the collisions estimate. With a = 0 the
+//   image is therefore exact and noise-free;
+// * Russian roulette from the `roulette_start`-th collision on: survive with
+//   probability min(1, weight), the survivor's weight divided by it.
+// Two guards, both measure-zero in practice and counted where they act: a
+// path is capped after kTruthMaxOrders collisions (counted), and a star
+// closer than 1e-12 voxel edges to a collision sends nothing (keeps floats
+// finite; the ball has probability ~1e-36).
+#include <cstdint>
+
+#include "core/dda.h"
+#include "core/grid.h"
+#include "core/hd.h"
+#include "core/math.h"
+#include "core/philox.h"
+#include "core/vec3.h"
+#include "montecarlo/henyey_greenstein.h"
+#include "raycast/camera.h"
+#include "raycast/ray_march.h"  // kMaxBands
+#include "validation/majorant_grid.h"
+
+namespace nebula {
+
+constexpr int kTruthMaxOrders = 100000;
+constexpr uint32_t kPurposeTruth = 0x5054u;  // "PT"
+
+struct TruthStarView {
+  Vec3 position;
+  float power[kMaxBands];  // band power, L_sun
+};
+
+// Everything a path needs, by value (pointers to host or device memory).
+struct PathScene {
+  DensityView density;
+  MajorantView majorant;
+  int n_bands = 0;
+  float extinction_ratio[kMaxBands];  // A_b / A_V
+  float albedo[kMaxBands];
+  float g[kMaxBands];
+  const float* emission[kMaxBands];   // j per voxel and band, or null
+  const TruthStarView* stars = nullptr;
+  int n_stars = 0;
+  uint64_t seed = 1;
+  int max_orders = 0;      // 0: unlimited (the truth); k > 0: orders 1..k only (tests, studies)
+  int roulette_start = 3;  // collisions before Russian roulette plays
+  bool exact_transmittance = false;  // NEE: exact DDA sum over voxels instead of ratio tracking
+  bool equiangular = false;  // NEE also from equiangular samples towards each star, MIS with the collisions
+};
+
+struct PathCounters {
+  uint64_t vertices = 0;   // real collisions (path vertices with next-event estimation)
+  uint64_t tentative = 0;  // tentative collisions of delta and ratio tracking
+  uint64_t capped = 0;     // paths ended at kTruthMaxOrders
+};
+
+// Uniforms of one path: Philox blocks (draw, pixel, sample, purpose|band)
+// under the scene's seed, handed out four at a time. The same numbers on
+// every backend and launch shape.
+struct PathRng {
+  uint64_t seed;
+  uint32_t pixel, sample, stream;
+  uint32_t draw = 0;
+  int left = 0;
+  Uniform4 buf{};
+  NEBULA_HD PathRng(uint64_t seed_, uint32_t pixel_, uint32_t sample_, uint32_t band)
+      : seed(seed_), pixel(pixel_), sample(sample_), stream((kPurposeTruth << 8) | band) {}
+  NEBULA_HD float next() {
+    if (left == 0) {
+      buf = philox_uniform4(seed, draw++, pixel, sample, stream);
+      left = 4;
+    }
+    const float v = left == 4 ? buf.u0 : (left == 3 ? buf.u1 : (left == 2 ? buf.u2 : buf.u3));
+    --left;
+    return v;
+  }
+};
+
+// tau_v of the voxel holding p (clamped to the grid).
+NEBULA_HD float tau_v_at(const DensityView& d, Vec3 p) {
+  const GridShape& g = d.shape;
+  const float inv = 1.0f / g.voxel;
+  int x = static_cast<int>(floorf((p.x - g.origin.x) * inv));
+  int y = static_cast<int>(floorf((p.y - g.origin.y) * inv));
+  int z = static_cast<int>(floorf((p.z - g.origin.z) * inv));
+  x = x < 0 ? 0 : (x >= g.nx ? g.nx - 1 : x);
+  y = y < 0 ? 0 : (y >= g.ny ? g.ny - 1 : y);
+  z = z < 0 ? 0 : (z >= g.nz ? g.nz - 1 : z);
+  return d.tau_v[g.index(x, y, z)];
+}
+
+// A length beyond which a ray from `origin` has left the grid.
+NEBULA_HD float beyond_grid(const GridShape& g, Vec3 origin) {
+  const Vec3 span = g.upper() - g.origin;
+  return length(origin - (g.origin + 0.5f * span)) + length(span) + g.voxel;
+}
+
+// Delta tracking from `origin` along unit `dir` in a band whose sigma_ext is
+// tau_v * scale: true and the collision point when a real collision happens
+// inside the grid, false when the ray leaves it.
+template <class Rng>
+NEBULA_HD bool delta_track(const PathScene& s, float scale, Vec3 origin, Vec3 dir, Rng& rng, Vec3& hit,
+                           PathCounters& c) {
+  const GridShape& g = s.density.shape;
+  float t0, t1;
+  if (!clip_to_grid(g, origin, dir, beyond_grid(g, origin), t0, t1)) return false;
+  float xi = -logf(rng.next());  // majorant optical depth to the next tentative collision
+  float t = t0;
+  bool collided = false;
+  traverse_segment_cells(s.majorant.shape, origin + t0 * dir, origin + t1 * dir,
+                         [&](int, int, int, size_t cell, float chord) -> bool {
+                           const float m = s.majorant.max_tau_v[cell] * scale;
+                           float left = chord;
+                           if (m > 0.0f) {
+                             while (xi < m * left) {
+                               const float step = xi / m;
+                               t += step;
+                               left -= step;
+                               ++c.tentative;
+                               const Vec3 p = origin + t * dir;
+                               if (rng.next() * m < tau_v_at(s.density, p) * scale) {
+                                 hit = p;
+                                 collided = true;
+                                 return false;
+                               }
+                               xi = -logf(rng.next());
+                             }
+                             xi -= m * left;
+                           }
+                           t += left;
+                           return true;
+                         });
+  return collided;
+}
+
+// Residual ratio tracking (Novak, Selle & Jarosz 2014) of the transmittance
+// from a to b: per majorant block, exp(-min * chord) exactly, times the
+// product of (1 - (sigma - min) / (max - min)) over tentative points drawn
+// at rate max - min. Unbiased; exact (no tentative point) in uniform blocks.
+template <class Rng>
+NEBULA_HD float ratio_track(const PathScene& s, float scale, Vec3 a, Vec3 b, Rng& rng, PathCounters& c) {
+  const GridShape& g = s.density.shape;
+  const Vec3 d = b - a;
+  const float len = length(d);
+  if (!(len > 0.0f)) return 1.0f;
+  const Vec3 dir = (1.0f / len) * d;
+  float t0, t1;
+  if (!clip_to_grid(g, a, dir, len, t0, t1)) return 1.0f;
+  float weight = 1.0f, control = 0.0f;
+  float t = t0;
+  traverse_segment_cells(s.majorant.shape, a + t0 * dir, a + t1 * dir,
+                         [&](int, int, int, size_t cell, float chord) -> bool {
+                           const float lo = s.majorant.min_tau_v[cell] * scale;
+                           const float residual = s.majorant.max_tau_v[cell] * scale - lo;
+                           control += lo * chord;
+                           if (residual > 0.0f) {
+                             float local = -logf(rng.next()) / residual;
+                             while (local < chord) {
+                               ++c.tentative;
+                               const float sigma = tau_v_at(s.density, a + (t + local) * dir) * scale;
+                               // In [0, 1] by the majorant grid's border; fmaxf never acts.
+                               weight *= fmaxf(0.0f, 1.0f - (sigma - lo) / residual);
+                               if (!(weight > 0.0f)) return false;
+                               local += -logf(rng.next()) / residual;
+                             }
+                           }
+                           t += chord;
+                           return true;
+                         });
+  return weight > 0.0f ? weight * expf(-control) : 0.0f;
+}
+
+// Exact emission radiance along the ray from `origin` in band b to the grid's
+// edge: sum over voxels of T_in (j / l) (1 - exp(-sigma c)) / sigma.
+NEBULA_HD float emission_along(const PathScene& s, int b, float scale, Vec3 origin, Vec3 dir) {
+  const float* j = s.emission[b];
+  if (!j) return 0.0f;
+  const GridShape& g = s.density.shape;
+  const float inv_voxel = 1.0f / g.voxel;
+  float radiance = 0.0f, depth = 0.0f;
+  traverse_segment_cells(g, origin, origin + beyond_grid(g, origin) * dir,
+                         [&](int, int, int, size_t cell, float chord) {
+                           const float sigma = s.density.tau_v[cell] * scale;
+                           const float od = sigma * chord;
+                           // (1 - e^-od) / sigma, with its series where od is small.
+                           const float path = od > 1e-3f ? -expm1f(-od) / sigma : chord * (1.0f - 0.5f * od);
+                           radiance += expf(-depth) * j[cell] * inv_voxel * path;
+                           depth += od;
+                         });
+  return radiance;
+}
+
+// Light from `star` scattered at x towards -dir per unit sigma_sct:
+// Phi / (4 pi r^2) T(star -> x) p_HG(mu); 0 within 1e-12 voxel of the star.
+template <class Rng>
+NEBULA_HD float star_light(const PathScene& s, int b, float scale, Vec3 x, Vec3 dir, const TruthStarView& star,
+                           Rng& rng, PathCounters& c) {
+  const Vec3 d = x - star.position;  // the light's direction before scattering
+  const float r2 = dot(d, d);
+  const float near2 = 1e-24f * s.density.shape.voxel * s.density.shape.voxel;
+  if (!(r2 > near2) || !(star.power[b] > 0.0f)) return 0.0f;
+  const float mu = dot(d, -dir) / sqrtf(r2);  // after scattering it goes back along the path
+  const float t = s.exact_transmittance
+                      ? expf(-s.extinction_ratio[b] * segment_optical_depth(s.density, x, star.position))
+                      : ratio_track(s, scale, x, star.position, rng, c);
+  return star.power[b] * kInv4Pi / r2 * t * hg_phase(s.g[b], mu);
+}
+
+// Equiangular sampling of a point on the ray o + t dir, t in [t0, t1], with
+// density proportional to 1 / r^2 from a point c (Kulla & Fajardo 2012):
+// its pdf cancels the star's 1/r^2, so the weights stay bounded near a star.
+struct Equiangular {
+  float delta = 0, dist = 0, theta0 = 0, theta1 = 0, t0 = 0, t1 = 0;
+  bool ok = false;
+  NEBULA_HD Equiangular(Vec3 o, Vec3 dir, Vec3 c, float t0_, float t1_, float min_dist) : t0(t0_), t1(t1_) {
+    delta = dot(c - o, dir);
+    dist = length(c - (o + delta * dir));
+    if (!(dist > min_dist)) return;
+    theta0 = atan2f(t0 - delta, dist);
+    theta1 = atan2f(t1 - delta, dist);
+    ok = theta1 > theta0;
+  }
+  NEBULA_HD float sample(float u) const { return delta + dist * tanf(theta0 + u * (theta1 - theta0)); }
+  NEBULA_HD float pdf(float t) const {
+    if (!ok || t < t0 || t > t1) return 0.0f;
+    const float x = t - delta;
+    return dist / ((theta1 - theta0) * (dist * dist + x * x));
+  }
+};
+
+// One path of band b from `origin` along unit `dir`: its radiance estimate.
+template <class Rng>
+NEBULA_HD float trace_path(const PathScene& s, int b, Vec3 origin, Vec3 dir, Rng& rng, PathCounters& c) {
+  const float a = s.albedo[b], g = s.g[b];
+  const float scale = s.extinction_ratio[b] / s.density.shape.voxel;
+  const bool emits = s.emission[b] != nullptr;
+  const GridShape& grid = s.density.shape;
+  const float min_dist = 1e-6f * grid.voxel;
+  if (!emits && (s.n_stars == 0 || !(a > 0.0f))) return 0.0f;
+  float weight = 1.0f, radiance = 0.0f;
+  Vec3 pos = origin;
+  for (int order = 0;;) {
+    if (emits) radiance += weight * emission_along(s, b, scale, pos, dir);
+    if (!(a > 0.0f)) break;
+    // With equiangular sampling, next-event estimation on this segment has two
+    // techniques per star, combined by the balance heuristic: a point drawn
+    // towards the star (pdf p_e) and the delta-tracking collision (pdf
+    // p_d(t) = sigma_ext(t) T(0, t)). Each contributes f / (p_e + p_d), with
+    // f = T(0, t) sigma_sct(t) star_light(t); T(0, t) by the exact voxel sum.
+    float seg0 = 0.0f, seg1 = 0.0f;
+    const bool mis = s.equiangular && clip_to_grid(grid, pos, dir, beyond_grid(grid, pos), seg0, seg1);
+    if (mis) {
+      for (int k = 0; k < s.n_stars; ++k) {
+        const Equiangular e(pos, dir, s.stars[k].position, seg0, seg1, min_dist);
+        if (!e.ok) continue;
+        const float te = e.sample(rng.next());
+        const float pe = e.pdf(te);
+        if (!(pe > 0.0f)) continue;
+        const Vec3 xe = pos + te * dir;
+        const float sigma = tau_v_at(s.density, xe) * scale;
+        if (!(sigma > 0.0f)) continue;
+        const float tr = expf(-s.extinction_ratio[b] * segment_optical_depth(s.density, pos, xe));
+        const float f = tr * a * sigma * star_light(s, b, scale, xe, dir, s.stars[k], rng, c);
+        radiance += weight * f / (pe + sigma * tr);
+      }
+    }
+    const Vec3 from = pos;
+    Vec3 hit;
+    if (!delta_track(s, scale, pos, dir, rng, hit, c)) break;
+    pos = hit;
+    ++order;
+    ++c.vertices;
+    float tr_hit = 1.0f, sigma_hit = 0.0f, t_hit = 0.0f;
+    if (mis) {
+      t_hit = length(hit - from);
+      tr_hit = expf(-s.extinction_ratio[b] * segment_optical_depth(s.density, from, hit));
+      sigma_hit = tau_v_at(s.density, hit) * scale;
+    }
+    for (int k = 0; k < s.n_stars; ++k) {
+      const float light = star_light(s, b, scale, pos, dir, s.stars[k], rng, c);
+      if (!(light > 0.0f)) continue;
+      float pe = 0.0f;
+      if (mis) pe = Equiangular(from, dir, s.stars[k].position, seg0, seg1, min_dist).pdf(t_hit);
+      // Without the other technique (pe = 0) this is weight x a x light: the
+      // collision estimator, sigma_sct T / (sigma_ext T).
+      radiance += pe > 0.0f ? weight * tr_hit * a * sigma_hit * light / (sigma_hit * tr_hit + pe) : weight * a * light;
+    }
+    if (s.max_orders > 0 && order >= s.max_orders) break;
+    if (order >= kTruthMaxOrders) {
+      ++c.capped;
+      break;
+    }
+    weight *= a;
+    if (order >= s.roulette_start) {
+      const float q = fminf(1.0f, weight);
+      if (rng.next() >= q) break;
+      weight /= q;
+    }
+    const float u0 = rng.next(), u1 = rng.next();
+    float sin_phi, cos_phi;
+    sin_cos_2pi(u1, sin_phi, cos_phi);
+    // HG is symmetric in its two directions: sampling about the path's
+    // direction is sampling the light's deflection.
+    dir = scatter_direction(dir, hg_sample(g, u0), sin_phi, cos_phi);
+  }
+  return radiance;
+}
+
+// All samples of pixel (x, y): mean and variance of the mean per band
+// (exposure applied), from double sums. spp >= 2.
+NEBULA_HD void trace_pixel(const PathScene& s, const Camera& camera, float exposure, int x, int y, int spp,
+                           float* mean, float* variance, PathCounters& c) {
+  for (int b = 0; b < s.n_bands; ++b) mean[b] = variance[b] = 0.0f;
+  Vec3 origin, dir;
+  if (!camera.ray(x, y, origin, dir)) return;
+  const uint32_t pixel = static_cast<uint32_t>(y) * static_cast<uint32_t>(camera.width) + static_cast<uint32_t>(x);
+  for (int b = 0; b < s.n_bands; ++b) {
+    double sum = 0.0, sum2 = 0.0;
+    for (int k = 0; k < spp; ++k) {
+      PathRng rng(s.seed, pixel, static_cast<uint32_t>(k), static_cast<uint32_t>(b));
+      const double v = trace_path(s, b, origin, dir, rng, c);
+      sum += v;
+      sum2 += v * v;
+    }
+    const double n = spp;
+    const double m = sum / n;
+    const double var = (sum2 - sum * m) / (n * (n - 1.0));
+    mean[b] = static_cast<float>(exposure * m);
+    variance[b] = static_cast<float>(double(exposure) * exposure * (var > 0.0 ? var : 0.0));
+  }
+}
+
+}  // namespace nebula
