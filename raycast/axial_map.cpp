@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/grid.h"
 #include "core/math.h"
 
 namespace nebula {
@@ -88,6 +89,39 @@ void check_axial_map(const AxialMap& map, const std::string& what) {
   };
   check_values(map.tau_v, "tau_v");
   for (size_t b = 0; b < map.emission.size(); ++b) check_values(map.emission[b], "emission " + std::to_string(b));
+}
+
+DensityGrid voxelize_axial_map(const AxialMap& map, float voxel, std::vector<std::vector<float>>* emission) {
+  const Vec3 a = map.axis, end = map.origin + map.length() * a;
+  const float R = map.radius();
+  const float lo[3] = {std::fmin(map.origin.x, end.x) - R * std::sqrt(std::fmax(0.0f, 1 - a.x * a.x)),
+                       std::fmin(map.origin.y, end.y) - R * std::sqrt(std::fmax(0.0f, 1 - a.y * a.y)),
+                       std::fmin(map.origin.z, end.z) - R * std::sqrt(std::fmax(0.0f, 1 - a.z * a.z))};
+  const float hi[3] = {std::fmax(map.origin.x, end.x) + R * std::sqrt(std::fmax(0.0f, 1 - a.x * a.x)),
+                       std::fmax(map.origin.y, end.y) + R * std::sqrt(std::fmax(0.0f, 1 - a.y * a.y)),
+                       std::fmax(map.origin.z, end.z) + R * std::sqrt(std::fmax(0.0f, 1 - a.z * a.z))};
+  DensityGrid g;
+  g.shape.voxel = voxel;
+  g.shape.origin = {lo[0], lo[1], lo[2]};
+  g.shape.nx = std::max(1, int(std::ceil((hi[0] - lo[0]) / voxel)));
+  g.shape.ny = std::max(1, int(std::ceil((hi[1] - lo[1]) / voxel)));
+  g.shape.nz = std::max(1, int(std::ceil((hi[2] - lo[2]) / voxel)));
+  g.tau_v.assign(g.shape.count(), 0.0f);
+  if (emission) emission->assign(map.emission.size(), std::vector<float>(g.shape.count(), 0.0f));
+  const float rescale = voxel / map.texel;  // per texel edge -> per voxel edge
+  for (int z = 0; z < g.shape.nz; ++z)
+    for (int y = 0; y < g.shape.ny; ++y)
+      for (int x = 0; x < g.shape.nx; ++x) {
+        const Vec3 q = g.shape.centre(x, y, z) - map.origin;
+        const float ax = dot(q, a), r = length(q - ax * a);
+        const float fx = std::floor(ax / map.texel), fr = std::floor(r / map.texel);
+        if (!(fx >= 0 && fx < map.nx && fr < map.nr)) continue;
+        const size_t t = map.index(int(fx), int(fr)), v = g.shape.index(x, y, z);
+        g.tau_v[v] = map.tau_v[t] * rescale;
+        if (emission)
+          for (size_t b = 0; b < map.emission.size(); ++b) (*emission)[b][v] = map.emission[b][t] * rescale;
+      }
+  return g;
 }
 
 const std::vector<std::string>& synthetic_axial_map_names() {

@@ -103,6 +103,13 @@ struct AxialMap {
 // axis, a texel <= 0, or NaN, infinite or negative values.
 void check_axial_map(const AxialMap& map, const std::string& what);
 
+// The map voxelized to a 3D grid of edge `voxel` spanning the cylinder's
+// bounding box: each voxel takes the texel holding its centre's (x, r), zero
+// outside the map; tau_v is rescaled from per texel edge to per voxel edge.
+// `emission` (may be null) receives one grid per emission band, rescaled alike.
+struct DensityGrid;
+DensityGrid voxelize_axial_map(const AxialMap& map, float voxel, std::vector<std::vector<float>>* emission);
+
 // The built-in maps: "bipolar" (two thin-walled lobes: mostly empty),
 // "lopsided" (a dense asymmetric cloud with an emitting core), "shells"
 // (three round concentric shells, the inner one emitting), "empty" and

@@ -190,6 +190,12 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
   const float inv_texel = 1.0f / m.texel;
   const Vec3 to_eye = -dir;
   bool previous_empty = false;
+  // The texel a run of samples is in and the transmittance where the ray
+  // entered it: every sample in the run is seen through that (the texel plays
+  // the voxel's part: P holds the extinction inside it).
+  long long run_cell = -1;
+  float t_entry[kMaxBands];
+  for (int b = 0; b < kMaxBands; ++b) t_entry[b] = 1.0f;
   for (int k = k_begin; k < k_end; ++k) {
     if (visited) ++*visited;
     float chord = h, t = t_in + (float(k) + 0.5f) * h;
@@ -241,16 +247,21 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
         }
       }
       empty = empty || dark;
-      // T_in rule (DESIGN.md section 3) with the step in the voxel's part.
+      // T_in rule (DESIGN.md section 3), the texel in the voxel's part.
+      const long long cell = empty ? -1 : static_cast<long long>(m.index(ix, ir));
+      if (cell != run_cell)
+        for (int b = 0; b < s.n_bands; ++b) t_entry[b] = out.transmittance[b];
+      run_cell = cell;
       const float fraction = chord * inv_texel;
       bool visible = false;
       for (int b = 0; b < s.n_bands; ++b) {
-        out.radiance[b] += out.transmittance[b] * source[b] * fraction;
+        out.radiance[b] += t_entry[b] * source[b] * fraction;
         out.transmittance[b] *= expf(-tau_v * s.extinction_ratio[b] * fraction);
         visible = visible || out.transmittance[b] >= s.min_transmittance;
       }
       if (!visible) break;
     }
+    if (empty) run_cell = -1;  // also for samples never shaded: the same runs in every mode
     const bool gap_start = !previous_empty;
     previous_empty = empty;
     if (!empty || skip < int(AxialSkip::Omega)) continue;

@@ -19,8 +19,9 @@ struct AxialScene {
 
   // nx x nr texels of edge 0.1 around origin (0.3, -0.2, 0.5) along `axis`;
   // a star on the axis a third of the way along (none when star_power == 0).
-  AxialScene(const std::string& name, int nx, int nr, Vec3 axis = normalize(Vec3{1, 2, 3}), float star_power = 50.0f) {
-    map = synthetic_axial_map(name, nx, nr, 0.1f, 3, 3.0f);
+  AxialScene(const std::string& name, int nx, int nr, Vec3 axis = normalize(Vec3{1, 2, 3}), float star_power = 50.0f,
+             float tau_scale = 3.0f) {
+    map = synthetic_axial_map(name, nx, nr, 0.1f, 3, tau_scale);
     map.origin = {0.3f, -0.2f, 0.5f};
     map.axis = axis;
     table = thin_table(0.6, 72, 10.0);
