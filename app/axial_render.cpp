@@ -204,9 +204,11 @@ void run_axial_render(Scene& scene, const AxialCommandOptions& o) {
   meta.entries.push_back({"mode", std::string("axial ") + to_string(skip) + " step " + to_text(spec.step_texels) + " texel"});
   write_image(image, out, meta, o.force);
 
-  std::printf("rendered %s: %dx%d %s, %zu band(s), %zu star(s), axial map %dx%d, skip %s, step %g texel, %s\n",
+  std::printf("rendered %s: %dx%d %s, %zu band(s), %zu star(s), axial map %dx%d, skip %s%s, step %g texel, %s\n",
               scene.path.c_str(), camera.width, camera.height, to_string(scene.camera.kind), n_bands,
-              scene.stars.size(), map.nx, map.nr, to_string(skip), spec.step_texels, to_string(backend));
+              scene.stars.size(), map.nx, map.nr, to_string(skip),
+              stats.skip_used != skip ? " (ran naive: the map has no empty texel)" : "", spec.step_texels,
+              to_string(backend));
   std::printf("computed, and why:\n");
   for (size_t b = 0; b < n_bands; ++b)
     std::printf("  band %s: A/A_V %.4f (CCM89-family law, R_V %g, Bessell passband), albedo %g, g %g%s\n",

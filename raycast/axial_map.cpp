@@ -18,6 +18,8 @@ bool AxialMap::empty_at(size_t i) const {
 
 void AxialMap::update_skip_structures() {
   height.assign(size_t(nx), 0);
+  empty_texels = 0;
+  for (size_t i = 0; i < count(); ++i) empty_texels += empty_at(i);
   for (int ix = 0; ix < nx; ++ix)
     for (int ir = nr - 1; ir >= 0; --ir)
       if (!empty_at(index(ix, ir))) {

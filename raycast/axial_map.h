@@ -84,6 +84,7 @@ struct AxialMap {
   std::vector<int> tree;
   std::vector<int> level_offset;
   int global_max = 0;
+  size_t empty_texels = 0;  // texels with no dust and no emission
 
   size_t count() const { return size_t(nx) * nr; }
   float length() const { return nx * texel; }

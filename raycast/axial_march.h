@@ -35,7 +35,7 @@ enum class AxialSkip : int {
   Empty = 1,      // the height map decides a sample is empty before any texel fetch
   GlobalMax = 2,  // ... and only the samples inside the cylinder of radius H l are visited
   Omega = 3,      // ... and from an empty sample, jump omega_max (the rest) or omega_large = omega_max / 32
-  OmegaMulti = 4  // ... jumps of 2, 4, 8, ... samples up to the rest, range maxima from the max-tree
+  OmegaMulti = 4  // ... adaptive jumps (doubling on success, halving on failure), range maxima from the max-tree
 };
 
 const char* to_string(AxialSkip mode);
@@ -190,6 +190,7 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
   const float inv_texel = 1.0f / m.texel;
   const Vec3 to_eye = -dir;
   bool previous_empty = false;
+  int stride = 2;  // omega_multi's next jump, in samples
   // The texel a run of samples is in and the transmittance where the ray
   // entered it: every sample in the run is seen through that (the texel plays
   // the voxel's part: P holds the extinction inside it).
@@ -276,15 +277,17 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
       const int n = omega_large < rest ? omega_large : rest;
       if (n >= 2 && axial_detail::stretch_is_empty<false>(m, ray, t, t + float(n) * h, eps)) k += n;
     } else {
-      // Hierarchical: the rest of the ray, else the largest of 2, 4, 8, ...
-      // samples that is empty (range maxima from the max-tree).
-      if (axial_detail::stretch_is_empty<true>(m, ray, t, t + float(rest) * h, eps)) break;
-      int done = 0;
-      for (int n = 2; n < rest; n *= 2) {
-        if (!axial_detail::stretch_is_empty<true>(m, ray, t, t + float(n) * h, eps)) break;
-        done = n;
+      // Hierarchical: the rest of the ray once per run of empty samples, else
+      // one adaptive jump: n doubles after each success and halves after a
+      // failure (range maxima from the max-tree, O(log nx) each).
+      if (gap_start && axial_detail::stretch_is_empty<true>(m, ray, t, t + float(rest) * h, eps)) break;
+      const int n = stride < rest ? stride : rest;
+      if (n >= 2 && axial_detail::stretch_is_empty<true>(m, ray, t, t + float(n) * h, eps)) {
+        k += n;
+        stride = 2 * n;
+      } else {
+        stride = n / 2 > 2 ? n / 2 : 2;
       }
-      k += done;
     }
   }
   return out;

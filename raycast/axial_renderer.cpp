@@ -29,6 +29,10 @@ AxialSkip parse_axial_skip(const std::string& text, const std::string& option) {
   throw Error(option + ": '" + text + "' is not a skip mode (known: naive, empty, global_max, omega, omega_multi)");
 }
 
+AxialSkip effective_skip(const AxialRenderInputs& in) {
+  return in.step_aside && in.map->empty_texels == 0 ? AxialSkip::Naive : in.skip;
+}
+
 float effective_step(const AxialRenderInputs& in) { return in.step > 0 ? in.step : 0.5f * in.map->texel; }
 
 void validate(const AxialRenderInputs& in) {
@@ -69,7 +73,7 @@ Image render_axial_cpu(const AxialRenderInputs& in, AxialRenderStats* stats) {
   scene.n_bands = static_cast<int>(in.bands.size());
   scene.min_transmittance = in.min_transmittance;
   scene.step = effective_step(in);
-  scene.skip = in.skip;
+  scene.skip = effective_skip(in);
   for (int b = 0; b < scene.n_bands; ++b) {
     const AxialRenderBand& band = in.bands[size_t(b)];
     scene.extinction_ratio[b] = band.extinction_ratio;
@@ -110,6 +114,7 @@ Image render_axial_cpu(const AxialRenderInputs& in, AxialRenderStats* stats) {
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     stats->table_clamps = clamps;
     stats->samples = reads;
+    stats->skip_used = scene.skip;
     stats->device_bytes = in.map->bytes() + in.stars.size() * in.map->count() * sizeof(float);
   }
   return image;

@@ -38,6 +38,7 @@ struct AxialRenderInputs {
   float min_transmittance = 1e-4f;
   float step = 0;  // h in world units; 0 means half a texel
   AxialSkip skip = AxialSkip::OmegaMulti;
+  bool step_aside = true;  // march naively when the map has no empty texel (effective_skip)
   Progress* progress = nullptr;  // CPU only, advanced in image rows; may be null
 };
 
@@ -46,11 +47,15 @@ struct AxialRenderStats {
   uint64_t table_clamps = 0;
   size_t device_bytes = 0;  // the map, skip structures, depths and tables the march reads
   uint64_t samples = 0; // samples the rays stepped through (CPU only)
+  AxialSkip skip_used = AxialSkip::Naive;  // effective_skip()
 };
 
 // Throws Error naming the problem (sizes, a star off the axis, a bad step).
 void validate(const AxialRenderInputs& in);
 float effective_step(const AxialRenderInputs& in);
+// The mode the march runs: in.skip, except the naive march when the map has
+// no empty texel (nothing can be skipped, so the checks would only cost).
+AxialSkip effective_skip(const AxialRenderInputs& in);
 // "naive", "empty", "global_max", "omega", "omega_multi"; Error naming `option` otherwise.
 AxialSkip parse_axial_skip(const std::string& text, const std::string& option);
 

@@ -73,7 +73,7 @@ Image render_axial_cuda(const AxialRenderInputs& in, AxialRenderStats* stats) {
   scene.n_bands = static_cast<int>(in.bands.size());
   scene.min_transmittance = in.min_transmittance;
   scene.step = effective_step(in);
-  scene.skip = in.skip;
+  scene.skip = effective_skip(in);
   std::vector<std::unique_ptr<DeviceTable>> tables;
   for (int b = 0; b < scene.n_bands; ++b) {
     const AxialRenderBand& band = in.bands[size_t(b)];
@@ -114,6 +114,7 @@ Image render_axial_cuda(const AxialRenderInputs& in, AxialRenderStats* stats) {
     stats->seconds = seconds;
     stats->table_clamps = clamp_count;
     stats->device_bytes = bytes;
+    stats->skip_used = scene.skip;
   }
   return image;
 }

@@ -33,6 +33,7 @@ struct AxialScene {
       inputs.stars.push_back(AxialRenderStar{map.origin + xs * map.axis, {star_power, star_power, star_power}, &depth[0]});
     }
     inputs.map = &map;
+    inputs.step_aside = false;  // run the skip code even on the full map
   }
 
   Vec3 centre() const { return map.origin + (0.5f * map.nx * map.texel) * map.axis; }
