@@ -150,9 +150,15 @@ NEBULA_HD bool stretch_is_empty(const AxialView& m, const AxialRay& ray, float t
   const float inv = 1.0f / m.texel;
   const float lo_f = fmaxf(floorf(x_min * inv), 0.0f), hi_f = fminf(floorf(x_max * inv), float(m.nx - 1));
   const int lo = static_cast<int>(lo_f), hi = static_cast<int>(hi_f);
-  const int h = kTree ? m.range_max_tree(lo, hi) : m.range_max_scan(lo, hi);
-  if (h == 0) return true;
-  return min_radius(ray, ta, tb) >= h * m.texel + eps;
+  const float r_min = min_radius(ray, ta, tb);
+  if (kTree) {
+    const int h = m.range_max_tree(lo, hi);
+    return h == 0 || r_min >= h * m.texel + eps;
+  }
+  // The scan stops at the first column reaching the ray.
+  for (int i = lo; i <= hi; ++i)
+    if (m.height[i] != 0 && !(r_min >= m.height[i] * m.texel + eps)) return false;
+  return true;
 }
 
 }  // namespace axial_detail
