@@ -26,6 +26,13 @@ void AxialMap::update_skip_structures() {
         height[size_t(ix)] = ir + 1;
         break;
       }
+  floor.assign(size_t(nx), kAxialEmptyFloor);
+  for (int ix = 0; ix < nx; ++ix)
+    for (int ir = 0; ir < nr; ++ir)
+      if (!empty_at(index(ix, ir))) {
+        floor[size_t(ix)] = ir;
+        break;
+      }
   global_max = nx > 0 ? *std::max_element(height.begin(), height.end()) : 0;
   // Max-tree: level 0 is h padded with zeros to a power of two; each level
   // halves the previous one, up to a single root.
@@ -33,11 +40,17 @@ void AxialMap::update_skip_structures() {
   while (padded < nx) padded *= 2;
   tree.assign(size_t(padded), 0);
   std::copy(height.begin(), height.end(), tree.begin());
+  floor_tree.assign(size_t(padded), kAxialEmptyFloor);
+  std::copy(floor.begin(), floor.end(), floor_tree.begin());
   level_offset = {0};
   for (int size = padded, at = 0; size > 1; size /= 2) {
     const int next = at + size;
     tree.resize(size_t(next + size / 2));
-    for (int i = 0; i < size / 2; ++i) tree[size_t(next + i)] = std::max(tree[size_t(at + 2 * i)], tree[size_t(at + 2 * i + 1)]);
+    floor_tree.resize(size_t(next + size / 2));
+    for (int i = 0; i < size / 2; ++i) {
+      tree[size_t(next + i)] = std::max(tree[size_t(at + 2 * i)], tree[size_t(at + 2 * i + 1)]);
+      floor_tree[size_t(next + i)] = std::min(floor_tree[size_t(at + 2 * i)], floor_tree[size_t(at + 2 * i + 1)]);
+    }
     level_offset.push_back(next);
     at = next;
   }
@@ -54,7 +67,9 @@ AxialView AxialMap::view() const {
   v.tau_v = tau_v.data();
   for (size_t b = 0; b < emission.size() && b < size_t(kAxialMaxBands); ++b) v.emission[b] = emission[b].data();
   v.height = height.data();
+  v.floor = floor.data();
   v.tree = tree.data();
+  v.floor_tree = floor_tree.data();
   v.n_levels = static_cast<int>(level_offset.size());
   for (int k = 0; k < v.n_levels; ++k) v.level_offset[k] = level_offset[size_t(k)];
   v.global_max = global_max;
@@ -64,7 +79,7 @@ AxialView AxialMap::view() const {
 size_t AxialMap::bytes() const {
   size_t floats = tau_v.size();
   for (const auto& e : emission) floats += e.size();
-  return floats * sizeof(float) + (height.size() + tree.size()) * sizeof(int);
+  return floats * sizeof(float) + (height.size() + floor.size() + tree.size() + floor_tree.size()) * sizeof(int);
 }
 
 void check_axial_map(const AxialMap& map, const std::string& what) {

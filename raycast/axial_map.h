@@ -8,7 +8,9 @@
 //
 // For empty-space skipping the map carries, per x-column, the height map
 // h[ix] = 1 + the highest non-empty r index (0 for an empty column), its
-// global maximum H and a max-tree over h. Empty means tau_v == 0 and every
+// global maximum H and a max-tree over h; and the floor map f[ix] = the
+// lowest non-empty r index (kAxialEmptyFloor for an empty column) with a min-tree, for the
+// hollow inside of shells and lobes. Empty means tau_v == 0 and every
 // band's emission == 0.
 #include <string>
 #include <vector>
@@ -20,6 +22,7 @@ namespace nebula {
 
 constexpr int kAxialMaxBands = 4;  // equals kMaxBands of ray_march.h
 constexpr int kAxialMaxTreeLevels = 32;
+constexpr int kAxialEmptyFloor = 1 << 30;  // the floor of an empty column: every r is below it
 
 // A non-owning view for kernels (host or device pointers), by value.
 struct AxialView {
@@ -30,7 +33,9 @@ struct AxialView {
   const float* tau_v = nullptr;                   // [ir * nx + ix]
   const float* emission[kAxialMaxBands] = {};     // same layout, or null
   const int* height = nullptr;                    // [ix], 0..nr
+  const int* floor = nullptr;                     // [ix]: lowest non-empty r index, kAxialEmptyFloor for an empty column
   const int* tree = nullptr;                      // max-tree levels, level 0 = height padded
+  const int* floor_tree = nullptr;                // min-tree of floor, same levels (padded with kAxialEmptyFloor)
   int level_offset[kAxialMaxTreeLevels] = {};     // start of each level in `tree`
   int n_levels = 0;
   int global_max = 0;                             // H = max over h
@@ -61,6 +66,27 @@ struct AxialView {
     return m;
   }
 
+  // Smallest floor over columns [lo, hi] (clamped; kAxialEmptyFloor when outside), O(log nx).
+  NEBULA_HD int range_min_floor(int lo, int hi) const {
+    lo = lo < 0 ? 0 : lo;
+    hi = hi >= nx ? nx - 1 : hi;
+    int m = kAxialEmptyFloor;
+    for (int level = 0; lo <= hi && level < n_levels; ++level) {
+      const int* f = floor_tree + level_offset[level];
+      if (lo & 1) {
+        m = f[lo] < m ? f[lo] : m;
+        ++lo;
+      }
+      if (!(hi & 1)) {
+        m = f[hi] < m ? f[hi] : m;
+        --hi;
+      }
+      lo >>= 1;
+      hi >>= 1;
+    }
+    return m;
+  }
+
   // The same by scanning the height map (the plain omega-step).
   NEBULA_HD int range_max_scan(int lo, int hi) const {
     lo = lo < 0 ? 0 : lo;
@@ -81,7 +107,9 @@ struct AxialMap {
   std::vector<std::vector<float>> emission;  // empty, or one per band
   // Derived (update_skip_structures):
   std::vector<int> height;
+  std::vector<int> floor;       // lowest non-empty r index per column (kAxialEmptyFloor: empty column)
   std::vector<int> tree;
+  std::vector<int> floor_tree;  // min-tree of floor, levels as tree's
   std::vector<int> level_offset;
   int global_max = 0;
   size_t empty_texels = 0;  // texels with no dust and no emission

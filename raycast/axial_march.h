@@ -32,7 +32,7 @@ namespace nebula {
 // Ordered: each mode does everything the previous one does.
 enum class AxialSkip : int {
   Naive = 0,      // every sample: texel fetch and shading
-  Empty = 1,      // the height map decides a sample is empty before any texel fetch
+  Empty = 1,      // the height and floor maps decide a sample is empty before any texel fetch
   GlobalMax = 2,  // ... and only the samples inside the cylinder of radius H l are visited
   Omega = 3,      // ... and from an empty sample, jump omega_max (the rest) or omega_large = omega_max / 32
   OmegaMulti = 4  // ... adaptive jumps (doubling on success, halving on failure), range maxima from the max-tree
@@ -139,7 +139,8 @@ NEBULA_HD float min_radius(const AxialRay& ray, float ta, float tb) {
 }
 
 // Whether every point of the ray with t in [ta, tb], grown by eps on every
-// side, lies above the height map: then every sample there is empty.
+// side, lies above the height map or below the floor map of the columns it
+// crosses: then every sample there is empty.
 template <bool kTree>
 NEBULA_HD bool stretch_is_empty(const AxialView& m, const AxialRay& ray, float ta, float tb, float eps) {
   ta -= eps;
@@ -150,14 +151,22 @@ NEBULA_HD bool stretch_is_empty(const AxialView& m, const AxialRay& ray, float t
   const float inv = 1.0f / m.texel;
   const float lo_f = fmaxf(floorf(x_min * inv), 0.0f), hi_f = fminf(floorf(x_max * inv), float(m.nx - 1));
   const int lo = static_cast<int>(lo_f), hi = static_cast<int>(hi_f);
+  // r is convex along the ray: smallest at the clamped vertex, largest at an end.
   const float r_min = min_radius(ray, ta, tb);
+  const float r_max = fmaxf(length(ray.w0 + ta * ray.wd), length(ray.w0 + tb * ray.wd));
   if (kTree) {
     const int h = m.range_max_tree(lo, hi);
-    return h == 0 || r_min >= h * m.texel + eps;
+    if (h == 0 || r_min >= h * m.texel + eps) return true;
+    return r_max + eps <= m.range_min_floor(lo, hi) * m.texel;
   }
-  // The scan stops at the first column reaching the ray.
-  for (int i = lo; i <= hi; ++i)
-    if (m.height[i] != 0 && !(r_min >= m.height[i] * m.texel + eps)) return false;
+  // The scan stops as soon as neither holds.
+  bool above = true, below = true;
+  for (int i = lo; i <= hi; ++i) {
+    if (m.height[i] == 0) continue;  // an empty column
+    above = above && r_min >= m.height[i] * m.texel + eps;
+    below = below && r_max + eps <= m.floor[i] * m.texel;
+    if (!above && !below) return false;
+  }
   return true;
 }
 
@@ -197,6 +206,7 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
   const Vec3 to_eye = -dir;
   bool previous_empty = false;
   int stride = 2;  // omega_multi's next jump, in samples
+  int wait = 0, backoff = 1;  // empty samples to pass before the next attempt
   // The texel a run of samples is in and the transmittance where the ray
   // entered it: every sample in the run is seen through that (the texel plays
   // the voxel's part: P holds the extinction inside it).
@@ -217,7 +227,7 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
     const float fx = floorf(x * inv_texel), fr = floorf(r * inv_texel);
     bool empty = !(fx >= 0.0f && fx < float(m.nx) && fr < float(m.nr));  // outside (or NaN)
     const int ix = empty ? 0 : static_cast<int>(fx), ir = empty ? 0 : static_cast<int>(fr);
-    if (!empty && skip >= int(AxialSkip::Empty)) empty = ir >= m.height[ix];
+    if (!empty && skip >= int(AxialSkip::Empty)) empty = ir >= m.height[ix] || ir < m.floor[ix];
     if (skip == int(AxialSkip::Naive) || !empty) {
       float tau_v = 0.0f;
       float source[kMaxBands] = {};
@@ -273,27 +283,44 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
     previous_empty = empty;
     if (!empty || skip < int(AxialSkip::Omega)) continue;
     // From an empty sample k: skip samples k+1 .. k+n when the stretch from
-    // sample k's position to sample k+n's is above the height map.
+    // sample k's position to sample k+n's is empty. After a failed attempt the
+    // next ones wait (1, 2, 4, ... up to 32 empty samples), so the hollow
+    // parts the maps cannot prove empty cost few queries.
     const int rest = k_end - 1 - k;
     if (rest < 2) continue;
+    if (gap_start && (skip == int(AxialSkip::Omega)
+                          ? axial_detail::stretch_is_empty<false>(m, ray, t, t + float(rest) * h, eps)
+                          : axial_detail::stretch_is_empty<true>(m, ray, t, t + float(rest) * h, eps)))
+      break;  // omega_max: the rest of the ray, tried once per run of empty samples
+    if (wait > 0) {
+      --wait;
+      continue;
+    }
+    bool jumped = false;
     if (skip == int(AxialSkip::Omega)) {
-      // omega_max: the rest of the ray, tried once per run of empty samples
-      // (the scan is long); then omega_large = omega_max / 32.
-      if (gap_start && axial_detail::stretch_is_empty<false>(m, ray, t, t + float(rest) * h, eps)) break;
+      // omega_large = omega_max / 32, the columns' maximum scanned.
       const int n = omega_large < rest ? omega_large : rest;
-      if (n >= 2 && axial_detail::stretch_is_empty<false>(m, ray, t, t + float(n) * h, eps)) k += n;
+      if (n >= 2 && axial_detail::stretch_is_empty<false>(m, ray, t, t + float(n) * h, eps)) {
+        k += n;
+        jumped = true;
+      }
     } else {
-      // Hierarchical: the rest of the ray once per run of empty samples, else
-      // one adaptive jump: n doubles after each success and halves after a
-      // failure (range maxima from the max-tree, O(log nx) each).
-      if (gap_start && axial_detail::stretch_is_empty<true>(m, ray, t, t + float(rest) * h, eps)) break;
+      // Hierarchical: one adaptive jump, n doubling after each success and
+      // halving after a failure, range extrema from the trees (O(log nx)).
       const int n = stride < rest ? stride : rest;
       if (n >= 2 && axial_detail::stretch_is_empty<true>(m, ray, t, t + float(n) * h, eps)) {
         k += n;
         stride = 2 * n;
+        jumped = true;
       } else {
         stride = n / 2 > 2 ? n / 2 : 2;
       }
+    }
+    if (jumped) {
+      backoff = 1;
+    } else {
+      wait = backoff;
+      backoff = backoff < 32 ? 2 * backoff : 32;
     }
   }
   return out;

@@ -85,6 +85,12 @@ TEST(AxialMaxTree, RangeMaximaAgreeWithAScan) {
   for (int lo = -2; lo < 40; ++lo)
     for (int hi = lo; hi < 40; ++hi) ASSERT_EQ(v.range_max_tree(lo, hi), v.range_max_scan(lo, hi)) << lo << " " << hi;
   EXPECT_EQ(v.range_max_tree(0, 36), m.global_max);
+  for (int lo = -2; lo < 40; ++lo)
+    for (int hi = lo; hi < 40; ++hi) {
+      int f = kAxialEmptyFloor;
+      for (int i = std::max(lo, 0); i <= std::min(hi, 36); ++i) f = std::min(f, m.floor[size_t(i)]);
+      ASSERT_EQ(v.range_min_floor(lo, hi), f) << lo << " " << hi;
+    }
 }
 
 TEST(AxialMap, HeightMapIsTheHighestNonEmptyTexel) {
@@ -98,6 +104,10 @@ TEST(AxialMap, HeightMapIsTheHighestNonEmptyTexel) {
     for (int ix = 0; ix < m.nx; ++ix)
       if (m.height[size_t(ix)] > 0) {
         EXPECT_FALSE(m.empty_at(m.index(ix, m.height[size_t(ix)] - 1))) << name;
+        EXPECT_FALSE(m.empty_at(m.index(ix, m.floor[size_t(ix)]))) << name;
+        for (int ir = 0; ir < m.floor[size_t(ix)]; ++ir) EXPECT_TRUE(m.empty_at(m.index(ix, ir))) << name;
+      } else {
+        EXPECT_EQ(m.floor[size_t(ix)], kAxialEmptyFloor);
       }
   }
   EXPECT_EQ(synthetic_axial_map("empty", 8, 8, 1.0f).global_max, 0);

@@ -66,10 +66,12 @@ Image render_axial_cuda(const AxialRenderInputs& in, AxialRenderStats* stats) {
   scene.map.tau_v = upload(m.tau_v);
   for (int b = 0; b < kAxialMaxBands; ++b) scene.map.emission[b] = nullptr;
   for (size_t b = 0; b < m.emission.size(); ++b) scene.map.emission[b] = upload(m.emission[b]);
-  DeviceBuffer<int> height(m.height), tree(m.tree);
-  bytes += height.bytes() + tree.bytes();
+  DeviceBuffer<int> height(m.height), floor(m.floor), tree(m.tree), floor_tree(m.floor_tree);
+  bytes += height.bytes() + floor.bytes() + tree.bytes() + floor_tree.bytes();
   scene.map.height = height.get();
+  scene.map.floor = floor.get();
   scene.map.tree = tree.get();
+  scene.map.floor_tree = floor_tree.get();
   scene.n_bands = static_cast<int>(in.bands.size());
   scene.min_transmittance = in.min_transmittance;
   scene.step = effective_step(in);
