@@ -68,5 +68,33 @@ TEST(AxialRendererGpu, SkippingModesMatchNaiveAndTheCpu) {
   }
 }
 
+// The axial bake (the 3D bake on an nx x nr x 1 grid) on both backends, with
+// illumination_gpu_tests' bound: each of the nx + nr texel boundaries a path
+// crosses may move by 4 L 2^-24 (FMA contraction) and hand that much of the
+// densest texel's depth to its neighbour, plus 1e-5 relative.
+TEST(AxialRendererGpu, BakeAgreesWithTheCpu) {
+  std::string why;
+  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  const AxialMap m = synthetic_axial_map("lopsided", 128, 64, 0.01f, 0, 3.0f);
+  float densest = 0;
+  for (float v : m.tau_v) densest = std::max(densest, v);
+  const std::vector<float> xs{0.2f, 0.64f, -0.1f};  // inside, at a texel edge, beyond the map's start
+  const BakeResult cpu = bake_axial_star_depths(m.nx, m.nr, m.texel, m.tau_v, xs, Backend::Cpu);
+  const BakeResult gpu = bake_axial_star_depths(m.nx, m.nr, m.texel, m.tau_v, xs, Backend::Cuda);
+  ASSERT_EQ(gpu.tau_v.size(), xs.size());
+  for (size_t s = 0; s < xs.size(); ++s) {
+    double worst = 0;
+    for (int ir = 0; ir < m.nr; ++ir)
+      for (int ix = 0; ix < m.nx; ++ix) {
+        const size_t i = m.index(ix, ir);
+        const double L = std::hypot((ix + 0.5) * m.texel - xs[s], (ir + 0.5) * m.texel);
+        const double bound = 1e-5 * cpu.tau_v[s][i] + (m.nx + m.nr) * 4 * L * 0x1p-24 / m.texel * densest + 1e-7;
+        worst = std::max(worst, std::fabs(double(gpu.tau_v[s][i]) - cpu.tau_v[s][i]) / bound);
+      }
+    std::printf("star at x = %g: worst CPU-GPU difference %.3g of its bound\n", xs[s], worst);
+    EXPECT_LE(worst, 1.0);
+  }
+}
+
 }  // namespace
 }  // namespace nebula
