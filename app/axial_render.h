@@ -17,7 +17,8 @@ struct AxialCommandOptions {
 };
 
 // The map a scene's [axial] table describes (synthetic, HDF5 or image), with
-// its skip structures; Error naming the key and the reason otherwise.
+// its skip structures; Error naming the key and the reason otherwise
+// (app/axial_map_source.cpp).
 AxialMap build_axial_map(const Scene& scene);
 
 void run_axial_render(Scene& scene, const AxialCommandOptions& o);
