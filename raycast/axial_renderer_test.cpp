@@ -144,6 +144,21 @@ TEST(AxialRender, VoxelizedGridRendersTheSameNebula) {
   }
 }
 
+// A map without empty texels is marched naively whatever the mode (nothing
+// can be skipped there); any other map runs the mode asked for.
+TEST(AxialRender, StepsAsideOnlyWhenNothingIsEmpty) {
+  for (const std::string name : {"full", "lopsided"}) {
+    AxialScene s(name, 24, 8);
+    s.inputs.camera = s.view(45, 8, 0);
+    s.inputs.step_aside = true;
+    s.inputs.skip = AxialSkip::Omega;
+    AxialRenderStats stats;
+    render_axial_cpu(s.inputs, &stats);
+    EXPECT_EQ(stats.skip_used, name == "full" ? AxialSkip::Naive : AxialSkip::Omega) << name;
+    EXPECT_EQ(s.map.empty_texels == 0, name == "full");
+  }
+}
+
 TEST(AxialRender, RefusesBadInputs) {
   AxialScene s("shells", 16, 8);
   s.inputs.camera = s.view(30, 4, 0);
