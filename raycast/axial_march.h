@@ -217,7 +217,7 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
     if (visited) ++*visited;
     float chord = h, t = t_in + (float(k) + 0.5f) * h;
     if (k == K - 1) {
-      chord = span - float(K - 1) * h;
+      chord = fmaxf(span - float(K - 1) * h, 0.0f);  // never negative, whatever ceil's rounding
       t = t_in + float(K - 1) * h + 0.5f * chord;
     }
     const Vec3 pos = origin + t * dir;
