@@ -14,7 +14,7 @@ namespace {
 using testing::AxialScene;
 
 struct Difference {
-  double peak = 0, worst = 0, mean = 0;
+  double peak = 0, worst = 0, mean = 0, flipped = 0;  // flipped: fraction of pixels off by > 1e-4 peak
 };
 
 Difference compare(const Image& a, const Image& ref) {
@@ -26,16 +26,21 @@ Difference compare(const Image& a, const Image& ref) {
     d.mean += e;
   }
   d.mean /= std::max<size_t>(1, ref.pixels.size());
+  for (size_t i = 0; i < ref.pixels.size(); ++i)
+    d.flipped += std::fabs(double(a.pixels[i]) - ref.pixels[i]) > 1e-4 * d.peak;
+  d.flipped /= std::max<size_t>(1, ref.pixels.size());
   return d;
 }
 
 // On one backend the skipping modes take the same arithmetic path through
-// the same non-empty samples as the naive march, so they are expected to be
-// bit-identical on the GPU too; nvcc may contract the shading differently in
-// the one kernel's inlined copies, so the test allows 1e-6 of the peak.
+// the same non-empty samples as the naive march (one kernel, the mode a
+// run-time argument), so they are expected to be bit-identical on the GPU
+// too; the test allows 1e-6 of the peak and prints any difference.
 // Against the CPU: float contraction (FMA) moves sample positions by ulps, so
-// a sample within rounding of a texel boundary may read the neighbour: at
-// most 1e-3 of the peak anywhere, 1e-5 of it on average.
+// a sample within rounding of a texel boundary may read the neighbour texel,
+// changing its pixel by up to one sample's contribution. Such flips are rare:
+// at most 1% of the pixels may differ by more than 1e-4 of the peak, the mean
+// difference must stay below 1e-5 of the peak and none may exceed 1/4 of it.
 TEST(AxialRendererGpu, SkippingModesMatchNaiveAndTheCpu) {
   std::string why;
   if (!gpu_available(&why)) GTEST_SKIP() << why;
@@ -49,11 +54,13 @@ TEST(AxialRendererGpu, SkippingModesMatchNaiveAndTheCpu) {
         const Image cpu = render_axial_cpu(s.inputs, nullptr);
         const Difference c = compare(naive, cpu);
         if (inc % 45 == 0)
-          std::printf("%s %d deg %s: GPU-CPU largest %.3g, mean %.3g of the peak %.3g\n", name.c_str(), inc,
-                      distance > 0 ? "perspective" : "orthographic", c.peak > 0 ? c.worst / c.peak : 0.0,
-                      c.peak > 0 ? c.mean / c.peak : 0.0, c.peak);
-        EXPECT_LE(c.worst, 1e-3 * c.peak) << name << " " << inc;
+          std::printf("%s %d deg %s: GPU-CPU largest %.3g, mean %.3g of the peak %.3g; %.3g%% of pixels > 1e-4\n",
+                      name.c_str(), inc, distance > 0 ? "perspective" : "orthographic",
+                      c.peak > 0 ? c.worst / c.peak : 0.0, c.peak > 0 ? c.mean / c.peak : 0.0, c.peak,
+                      100 * c.flipped);
+        EXPECT_LE(c.flipped, 0.01) << name << " " << inc;
         EXPECT_LE(c.mean, 1e-5 * c.peak) << name << " " << inc;
+        EXPECT_LE(c.worst, 0.25 * c.peak) << name << " " << inc;
         for (float v : naive.pixels) ASSERT_TRUE(std::isfinite(v));
         for (AxialSkip mode : {AxialSkip::Empty, AxialSkip::GlobalMax, AxialSkip::Omega, AxialSkip::OmegaMulti}) {
           s.inputs.skip = mode;
