@@ -40,7 +40,7 @@ Difference compare(const Image& a, const Image& ref) {
 // a sample within rounding of a texel boundary may read the neighbour texel,
 // changing its pixel by up to one sample's contribution. Such flips are rare:
 // at most 1% of the pixels may differ by more than 1e-4 of the peak, the mean
-// difference must stay below 1e-5 of the peak and none may exceed 1/4 of it.
+// difference must stay below 1e-4 of the peak and none may exceed 1/4 of it.
 TEST(AxialRendererGpu, SkippingModesMatchNaiveAndTheCpu) {
   std::string why;
   if (!gpu_available(&why)) GTEST_SKIP() << why;
@@ -59,7 +59,7 @@ TEST(AxialRendererGpu, SkippingModesMatchNaiveAndTheCpu) {
                       c.peak > 0 ? c.worst / c.peak : 0.0, c.peak > 0 ? c.mean / c.peak : 0.0, c.peak,
                       100 * c.flipped);
         EXPECT_LE(c.flipped, 0.01) << name << " " << inc;
-        EXPECT_LE(c.mean, 1e-5 * c.peak) << name << " " << inc;
+        EXPECT_LE(c.mean, 1e-4 * c.peak) << name << " " << inc;
         EXPECT_LE(c.worst, 0.25 * c.peak) << name << " " << inc;
         for (float v : naive.pixels) ASSERT_TRUE(std::isfinite(v));
         for (AxialSkip mode : {AxialSkip::Empty, AxialSkip::GlobalMax, AxialSkip::Omega, AxialSkip::OmegaMulti}) {
