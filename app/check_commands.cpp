@@ -231,7 +231,7 @@ void add_bench_command(CLI::App& app) {
     std::string backends = "auto", maps = "bipolar,lopsided,shells,empty,full", inclinations = "0,15,30,45,60,75,90";
     int map_size = 1024, image = 2048, repeats = 5;
     float step = 0.5f;
-    bool emission_only = false;
+    bool emission_only = false, step_aside = true;
   };
   auto x = std::make_shared<AxialOptions>();
   ax->add_option("--backend", x->backends, "cpu, cuda, both or auto")->capture_default_str();
@@ -243,6 +243,8 @@ void add_bench_command(CLI::App& app) {
   ax->add_option("--maps", x->maps, "comma-separated synthetic maps")->capture_default_str();
   ax->add_option("--inclinations", x->inclinations, "comma-separated degrees from the axis")->capture_default_str();
   ax->add_flag("--emission-only", x->emission_only, "no star: the thesis' emission-absorption model only");
+  ax->add_flag("!--no-step-aside", x->step_aside,
+               "run the skip code even on maps without empty texels (its overhead on the full map)");
   ax->callback([x] {
     if (x->map_size < 2 || x->map_size > 16384) throw Error("--map-size: must be 2 to 16384");
     if (x->image < 1 || x->image > 16384) throw Error("--image: must be 1 to 16384");
@@ -291,7 +293,8 @@ void add_bench_command(CLI::App& app) {
                                 r.mode.c_str(), r.ran.c_str(), r.median_ms, r.speedup, r.max_difference,
                                 (unsigned long long)r.samples);
                     std::fflush(stdout);
-                  });
+                  },
+                  x->step_aside);
     }
   });
 }

@@ -167,7 +167,7 @@ std::vector<RenderBenchRow> bench_render(Backend backend, int size, int width, i
 
 void bench_axial(Backend backend, int map_size, int width, int height, int repeats, float step_texels,
                  const std::vector<std::string>& maps, const std::vector<int>& inclinations, bool star,
-                 const std::function<void(const AxialBenchRow&)>& on_row) {
+                 const std::function<void(const AxialBenchRow&)>& on_row, bool step_aside) {
   ScatteringTable table;
   if (star) {
     TabulateParams tp;
@@ -194,6 +194,7 @@ void bench_axial(Backend backend, int map_size, int width, int height, int repea
       in.stars.push_back(AxialRenderStar{centre, {1.0f, 1.0f, 1.0f}, &depth[0]});
     }
     in.step = step_texels * texel;
+    in.step_aside = step_aside;
     for (int inc : inclinations) {
       const double i = inc * kPiD / 180.0;
       CameraSettings cs;

@@ -88,8 +88,10 @@ struct AxialBenchRow {
 // warm-up, then the median of `repeats`. With `star`, a B-type star on the
 // axis at the map's centre lights the dust (full physics, a = g = 0.6, three
 // bands); without it, emission-absorption only. Rows go to on_row as they come.
+// step_aside false runs the skip code even on maps without empty texels (to
+// measure its overhead there).
 void bench_axial(Backend backend, int map_size, int width, int height, int repeats, float step_texels,
                  const std::vector<std::string>& maps, const std::vector<int>& inclinations, bool star,
-                 const std::function<void(const AxialBenchRow&)>& on_row);
+                 const std::function<void(const AxialBenchRow&)>& on_row, bool step_aside = true);
 
 }  // namespace nebula
