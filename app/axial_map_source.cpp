@@ -1,4 +1,6 @@
+#include <cctype>
 #include <cstdio>
+#include <filesystem>
 
 #include "app/axial_render.h"
 #include "core/error.h"
@@ -13,9 +15,14 @@ namespace {
 void read_image_map(const Scene& scene, AxialMap& m) {
   const AxialSpec& a = *scene.axial;
   const std::string key = scene.path + ": axial.image: ";
+  // The project's float files through read_image (any EXR included), every
+  // other format OpenImageIO knows through read_any_image.
+  std::string ext = std::filesystem::path(a.path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const bool ours = ext == ".h5" || ext == ".fits" || ext == ".fit" || ext == ".exr";
   Image image;
   try {
-    image = read_image(a.path);
+    image = ours ? read_image(a.path) : read_any_image(a.path);
   } catch (const Error& e) {
     throw Error(key + e.what());
   }

@@ -77,5 +77,24 @@ TEST_F(AxialMapSource, ImageChannelsWithTheAxisAtTheBottom) {
                         {"axial.tau_channel", "'tau_v'", "dust, blue"});
 }
 
+// Any OpenImageIO format: a PNG (8-bit sRGB, channels R, G, B) read as floats in [0, 1].
+TEST_F(AxialMapSource, AnyOpenImageIoFormat) {
+  if (!openimageio_available()) GTEST_SKIP() << "this build has no OpenImageIO";
+  Image image(6, 4, {"B", "V", "R"});
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 6; ++x) image.at(1, x, y) = x == 0 ? 0.0f : 0.5f;
+  write_image(image, path("map.png"), ImageMetadata{}, false);
+  const AxialMap m = app::build_axial_map(scene("image = \"map.png\"\ntau_channel = \"G\""));
+  EXPECT_EQ(m.nx, 6);
+  EXPECT_EQ(m.nr, 4);
+  EXPECT_EQ(m.tau_v[m.index(0, 2)], 0.0f);
+  EXPECT_GT(m.tau_v[m.index(3, 2)], 0.0f);
+  EXPECT_LE(m.tau_v[m.index(3, 2)], 1.0f);
+  EXPECT_EQ(m.height[0], 0);
+  EXPECT_EQ(m.height[3], 4);
+  testing::expect_error([&] { app::build_axial_map(scene("image = \"map.png\"\ntau_channel = \"V\"")); },
+                        {"axial.tau_channel", "'V'", "R, G, B"});
+}
+
 }  // namespace
 }  // namespace nebula
