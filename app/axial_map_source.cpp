@@ -57,6 +57,14 @@ AxialMap build_axial_map(const Scene& scene) {
   const AxialSpec& a = *scene.axial;
   AxialMap m;
   if (a.source == "synthetic") {
+    // tau_v and one emission plane per band, refused before allocating when
+    // they would exceed half the memory (as density grids are).
+    try {
+      check_grid_size("synthetic map " + a.synthetic, uint64_t(a.nx), uint64_t(a.nr), 1,
+                      sizeof(float) * (1 + scene.bands.size()));
+    } catch (const Error& e) {
+      throw Error(scene.path + ": axial.nx: " + e.what());
+    }
     m = synthetic_axial_map(a.synthetic, a.nx, a.nr, 1.0f, int(scene.bands.size()));
   } else if (a.source == "file") {
     try {
