@@ -1,5 +1,7 @@
 // `nebula slab`, `nebula validate montecarlo` and `nebula bench tabulate`.
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <memory>
 #include <sstream>
@@ -11,6 +13,7 @@
 #include "core/progress.h"
 #include "montecarlo/slab.h"
 #include "validation/montecarlo_validation.h"
+#include "raycast/axial_map.h"
 #include "validation/benchmarks.h"
 
 namespace nebula::app {
@@ -309,6 +312,79 @@ void add_bench_command(CLI::App& app) {
                     row.spp_per_second * double(row.width) * row.height / (1920.0 * 1080.0), row.vertices_per_path);
         std::fflush(stdout);
       }
+  });
+
+  auto* ax = cmd->add_subcommand("axial", "axial maps: every skip mode on every synthetic map, 0 to 90 degrees "
+                                          "(Khalass 2021, Tables 5.1-5.5)");
+  struct AxialOptions {
+    std::string backends = "auto", maps = "bipolar,lopsided,shells,empty,full", inclinations = "0,15,30,45,60,75,90";
+    int map_size = 1024, image = 2048, repeats = 5;
+    float step = 0.5f;
+    bool emission_only = false, step_aside = true;
+  };
+  auto x = std::make_shared<AxialOptions>();
+  ax->add_option("--backend", x->backends, "cpu, cuda, both or auto")->capture_default_str();
+  ax->add_option("--map-size", x->map_size, "texels along the axis and radially")->capture_default_str();
+  ax->add_option("--image", x->image, "image width and height, pixels (the CPU renders 1/8 of it per side)")
+      ->capture_default_str();
+  ax->add_option("--repeats", x->repeats, "timed frames after the warm-up")->capture_default_str();
+  ax->add_option("--step", x->step, "march step, texels")->capture_default_str();
+  ax->add_option("--maps", x->maps, "comma-separated synthetic maps")->capture_default_str();
+  ax->add_option("--inclinations", x->inclinations, "comma-separated degrees from the axis")->capture_default_str();
+  ax->add_flag("--emission-only", x->emission_only, "no star: the thesis' emission-absorption model only");
+  ax->add_flag("!--no-step-aside", x->step_aside,
+               "run the skip code even on maps without empty texels (its overhead on the full map)");
+  ax->callback([x] {
+    if (x->map_size < 2 || x->map_size > 16384) throw Error("--map-size: must be 2 to 16384");
+    if (x->image < 1 || x->image > 16384) throw Error("--image: must be 1 to 16384");
+    if (x->repeats < 1) throw Error("--repeats: must be at least 1");
+    if (!(x->step >= 1e-3f && x->step <= 100)) throw Error("--step: must be in [1e-3, 100] texels");
+    auto split = [](const std::string& text) {
+      std::vector<std::string> out;
+      size_t begin = 0;
+      while (begin <= text.size()) {
+        const size_t comma = text.find(',', begin);
+        out.push_back(text.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin));
+        if (comma == std::string::npos) break;
+        begin = comma + 1;
+      }
+      return out;
+    };
+    const std::vector<std::string> maps = split(x->maps);
+    for (const std::string& m : maps) {
+      const auto& known = synthetic_axial_map_names();
+      if (std::find(known.begin(), known.end(), m) == known.end())
+        throw Error("--maps: '" + m + "' is not a synthetic map (known: bipolar, lopsided, shells, empty, full)");
+    }
+    std::vector<int> inclinations;
+    for (const std::string& t : split(x->inclinations)) {
+      char* end = nullptr;
+      const long v = std::strtol(t.c_str(), &end, 10);
+      if (t.empty() || *end != '\0' || v < 0 || v > 90) throw Error("--inclinations: '" + t + "' is not a whole degree in 0..90");
+      inclinations.push_back(int(v));
+    }
+    std::vector<Backend> backends;
+    if (x->backends == "both" || (x->backends == "auto" && gpu_available()))
+      backends = {Backend::Cpu, Backend::Cuda};
+    else
+      backends = {parse_backend(x->backends)};
+    for (Backend backend : backends) {
+      const int image = backend == Backend::Cpu ? std::max(1, x->image / 8) : x->image;
+      std::printf("\naxial maps, %s%s: map %d x %d texels, image %d x %d, step %g texel, %s; ms median of %d after a warm-up\n",
+                  to_string(backend), backend == Backend::Cuda ? (" (" + gpu_description() + ")").c_str() : "",
+                  x->map_size, x->map_size, image, image, x->step,
+                  x->emission_only ? "emission-absorption" : "one star on the axis (full physics)", x->repeats);
+      std::printf("| map | inclination | mode | ran | ms | speed-up vs naive | max diff / peak | samples |\n"
+                  "|---|---|---|---|---|---|---|---|\n");
+      bench_axial(backend, x->map_size, image, image, x->repeats, x->step, maps, inclinations, !x->emission_only,
+                  [](const AxialBenchRow& r) {
+                    std::printf("| %s | %d | %s | %s | %.3f | %.2f | %.3g | %llu |\n", r.map.c_str(), r.inclination_deg,
+                                r.mode.c_str(), r.ran.c_str(), r.median_ms, r.speedup, r.max_difference,
+                                (unsigned long long)r.samples);
+                    std::fflush(stdout);
+                  },
+                  x->step_aside);
+    }
   });
 }
 

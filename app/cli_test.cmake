@@ -134,3 +134,30 @@ file(GLOB temps ${WORK}/*.tmp*)
 if(temps)
   message(FATAL_ERROR "temporary files left: ${temps}")
 endif()
+
+# Axial maps: a synthetic map rendered to a float image, that image read back
+# as a map (tau_v from its V channel, emission from B), the benchmark, refusals.
+file(WRITE ${WORK}/axial.toml "bands = [\"B\", \"V\"]\n[axial]\nsynthetic = \"lopsided\"\nnx = 32\nnr = 16\nemission_scale = 1.0\n[camera]\nkind = \"orthographic\"\nposition = [4.0, 0.0, 1.0]\nlook_at = [0.0, 0.0, 1.0]\northo_width = 4.0\nwidth = 24\nheight = 24\n")
+execute_process(COMMAND ${NEBULA} render axial.toml -o axial_map.h5 --backend cpu -q RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                ERROR_VARIABLE err WORKING_DIRECTORY ${WORK})
+if(NOT rc EQUAL 0 OR NOT EXISTS ${WORK}/axial_map.h5)
+  message(FATAL_ERROR "axial render failed (${rc}): ${out} ${err}")
+endif()
+file(WRITE ${WORK}/axial_image.toml "bands = [\"B\", \"V\"]\n[axial]\nimage = \"axial_map.h5\"\ntau_channel = \"V\"\nemission_channels = { B = \"B\" }\ntau_scale = 10.0\n[camera]\nposition = [0.0, -5.0, 1.0]\nlook_at = [0.0, 0.0, 1.0]\nwidth = 16\nheight = 16\n")
+execute_process(COMMAND ${NEBULA} render axial_image.toml -o axial_image.h5 --backend cpu -q RESULT_VARIABLE rc
+                OUTPUT_VARIABLE out ERROR_VARIABLE err WORKING_DIRECTORY ${WORK})
+string(FIND "${out}" "axial map 24x24" at)
+if(NOT rc EQUAL 0 OR at EQUAL -1)
+  message(FATAL_ERROR "axial render from an image map failed (${rc}): ${out} ${err}")
+endif()
+expect_failure(axial_skip "axial.skip" render axial.toml --set axial.skip=fast -o bad.h5)
+expect_failure(axial_channel "axial.tau_channel" render axial_image.toml --set axial.tau_channel=X -o bad.h5)
+expect_failure(axial_smooth "--smooth" render axial.toml --smooth 0.5 -o bad.h5)
+expect_failure(bench_axial_map "--maps" bench axial --backend cpu --maps spiral)
+execute_process(COMMAND ${NEBULA} bench axial --backend cpu --map-size 16 --image 16 --repeats 1 --inclinations 0,90
+                        --maps bipolar,full --emission-only
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+string(FIND "${out}" "| full | 90 | omega_multi | naive |" at)
+if(NOT rc EQUAL 0 OR at EQUAL -1)
+  message(FATAL_ERROR "bench axial failed (${rc}): ${out} ${err}")
+endif()

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "app/axial_render.h"
 #include "app/commands.h"
 #include "app/output_path.h"
 #include "app/scene_setup.h"
@@ -49,6 +50,8 @@ void run_render(const Options& o) {
   if (o.demo && !o.overrides.empty())
     throw Error("--set: the demo takes no overrides; copy scenes/demo.toml and pass it instead");
   Scene scene = o.demo ? demo_scene() : load_scene(o.scene_path, o.overrides);
+  if (scene.axial)
+    return run_axial_render(scene, {o.out, o.backend, o.table_photons, o.force, o.quiet, o.width, o.height, o.smooth});
   if (o.width > 0) scene.camera.width = o.width;
   if (o.height > 0) scene.camera.height = o.height;
   if (o.width < 0 || o.height < 0) throw Error("--width/--height: must be positive");

@@ -45,6 +45,9 @@ constexpr int kSchemaVersion = 1;
 std::string join_bands(const std::vector<std::string>& bands);
 std::vector<std::string> split_bands(const std::string& text);
 
+// TEXT with line breaks turned into spaces (library messages in one-line errors).
+std::string one_line_text(std::string text);
+
 // Shortest text that reads back as the same double.
 std::string exact_text(double value);
 // Parses all of TEXT as a double; false if anything is left over.

@@ -15,7 +15,40 @@ namespace nebula {
 
 bool openimageio_available() { return true; }
 
+Image read_any_image(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw Error(path + ": cannot open as an image (" + imageio_detail::one_line_text(OIIO::geterror()) + ")");
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.deep || spec.depth != 1 || spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 ||
+      size_t(spec.nchannels) > imageio_detail::kMaxElements / size_t(spec.width) / size_t(spec.height))
+    throw Error(path + ": not a flat 2-D image of 1 to 2^29 values");
+  const size_t plane = size_t(spec.width) * spec.height;
+  std::vector<float> interleaved(plane * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, interleaved.data()))
+    throw Error(path + ": cannot read the pixels (" + imageio_detail::one_line_text(in->geterror()) + ")");
+  Image image;
+  image.width = spec.width;
+  image.height = spec.height;
+  image.bands = spec.channelnames;
+  image.pixels.resize(plane * spec.nchannels);
+  for (size_t c = 0; c < size_t(spec.nchannels); ++c)
+    for (size_t i = 0; i < plane; ++i) {
+      const float v = interleaved[i * spec.nchannels + c];
+      if (!std::isfinite(v))
+        throw Error(path + ": channel " + image.bands[c] + " at (x=" + std::to_string(i % spec.width) +
+                    ", y=" + std::to_string(i / spec.width) + ") is not finite");
+      image.pixels[c * plane + i] = v;
+    }
+  return image;
+}
+
 namespace imageio_detail {
+
+std::string one_line_text(std::string s) {
+  for (char& c : s)
+    if (c == '\n' || c == '\r') c = ' ';
+  return s;
+}
 
 namespace {
 

@@ -8,6 +8,11 @@ namespace nebula {
 
 bool openimageio_available() { return false; }
 
+Image read_any_image(const std::string& path) {
+  throw Error(path + ": cannot read: this build has no OpenImageIO (configure with -DNEBULA_OPENIMAGEIO=ON); "
+              "give the map as .h5 or .fits");
+}
+
 namespace imageio_detail {
 
 namespace {

@@ -39,6 +39,14 @@ void write_image(const Image& image, const std::string& path, const ImageMetadat
 // non-finite pixels with one line naming the file and the field.
 Image read_image(const std::string& path, ImageMetadata* metadata = nullptr);
 
+// Reads any image OpenImageIO can open (PNG, TIFF, JPEG, EXR, ...) as float
+// planes, for data such as axial maps (raycast/AXIAL.md): channels named as
+// the file names them (R, G, B, A; Y for a single grey channel), integer
+// formats scaled to [0, 1] by OpenImageIO, row 0 at the top. Refuses, with
+// one line naming the file: a build without OpenImageIO, an unreadable or
+// deep or 3-D image, non-finite values.
+Image read_any_image(const std::string& path);
+
 // Whether this build has OpenImageIO, and so .exr and .png.
 bool openimageio_available();
 

@@ -97,7 +97,7 @@ struct Hdf5Grid {
 
 // Opens `path`, checks `dataset` is a 3D numeric array that fits in memory,
 // reads voxel_size/origin when present and the values as float.
-Hdf5Grid read_hdf5_grid(const std::string& path, const std::string& dataset) {
+Hdf5Grid read_hdf5_grid(const std::string& path, const std::string& dataset, int want_rank = 3) {
   require_readable(path);
   const std::string what = path + ": dataset '" + dataset + "'";
   std::lock_guard<std::mutex> lock(hdf5io::hdf5_mutex());
@@ -115,10 +115,11 @@ Hdf5Grid read_hdf5_grid(const std::string& path, const std::string& dataset) {
     throw Error(what + ": must hold numbers (float or integer)");
   Handle space(H5Dget_space(set.get()), H5Sclose);
   const int rank = H5Sget_simple_extent_ndims(space.get());
-  if (rank != 3)
-    throw Error(what + ": must be 3-D [nz][ny][nx], found " + std::to_string(rank) + "-D");
-  hsize_t dims[3] = {0, 0, 0};
-  H5Sget_simple_extent_dims(space.get(), dims, nullptr);
+  if (rank != want_rank)
+    throw Error(what + (want_rank == 3 ? ": must be 3-D [nz][ny][nx], found " : ": must be 2-D [nr][nx], found ") +
+                std::to_string(rank) + "-D");
+  hsize_t dims[3] = {1, 0, 0};
+  H5Sget_simple_extent_dims(space.get(), want_rank == 3 ? dims : dims + 1, nullptr);
   check_grid_size(what, dims[2], dims[1], dims[0]);
   if (dims[0] > uint64_t(std::numeric_limits<int>::max()) ||
       dims[1] > uint64_t(std::numeric_limits<int>::max()) ||
@@ -270,6 +271,16 @@ std::vector<float> load_emission_hdf5(const std::string& path, const std::string
     throw Error(what + ": voxel_size " + to_text(s.voxel) + " differs from the density's " +
                 to_text(density_shape.voxel));
   check_grid_values(what, density_shape, grid.values, "emission");
+  return std::move(grid.values);
+}
+
+std::vector<float> load_axial_plane_hdf5(const std::string& path, const std::string& dataset, int& nx, int& nr,
+                                         const char* quantity) {
+  Hdf5Grid grid = read_hdf5_grid(path, dataset, 2);
+  const std::string what = path + ": dataset '" + dataset + "'";
+  check_grid_values(what, grid.shape, grid.values, quantity);
+  nx = grid.shape.nx;
+  nr = grid.shape.ny;
   return std::move(grid.values);
 }
 

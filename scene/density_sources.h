@@ -56,6 +56,12 @@ DensityGrid load_density_fits(const std::string& path, double voxel_size_pc = 0)
 std::vector<float> load_emission_hdf5(const std::string& path, const std::string& dataset,
                                       const GridShape& density_shape);
 
+// A 2D dataset [nr][nx] (C order, x fastest: x along an axial map's axis, r
+// away from it) of any float or integer type, read as float; values must be
+// finite and >= 0 (`quantity` names them in messages).
+std::vector<float> load_axial_plane_hdf5(const std::string& path, const std::string& dataset, int& nx, int& nr,
+                                         const char* quantity = "tau_v");
+
 // ------------------------------------------------------------ procedural
 
 // The 2005 paper's section 4.3 kind of reflection nebula (Magnor et al.,

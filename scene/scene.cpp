@@ -155,6 +155,7 @@ std::optional<SceneIssue> settings_issue(const Scene& s) {
 }
 
 std::optional<SceneIssue> grids_issue(const Scene& s) {
+  if (s.axial) return std::nullopt;  // the map is built and checked by the axial renderer
   const GridShape& g = s.density.shape;
   if (g.nx < 1 || g.ny < 1 || g.nz < 1)
     return SceneIssue{"density", "the grid has a zero size (" + std::to_string(g.nx) + " x " +

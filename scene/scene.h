@@ -7,6 +7,7 @@
 // star positions, camera); luminosity in solar luminosities; temperatures in
 // K. Rendered radiance is in L_sun pc^-2 sr^-1 per band times `exposure`, a
 // relative scale (no distance to the observer, no detector).
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,10 +50,33 @@ struct CameraSpec {
   double exposure = 1.0;          // radiance multiplier, > 0
 };
 
+// An axial-symmetric nebula ([axial] in a scene file, docs/scene.md): a 2D
+// map M(x, r) rotated about an axis, given instead of [density]. The scene
+// holds where the map comes from; app/axial_render.cpp builds it
+// (raycast/axial_map.h) and renders it with raycast/axial_renderer.h.
+struct AxialSpec {
+  std::string source;              // "synthetic", "file" (HDF5) or "image"
+  std::string synthetic;           // bipolar, lopsided, shells, empty, full
+  std::string path;                // file or image, resolved against the scene's folder
+  std::string dataset = "tau_v";   // file: the 2D dataset [nr][nx]
+  std::string emission_prefix;     // file: emission datasets <prefix><band>; "" = none
+  std::string tau_channel = "tau_v";           // image: the band (channel) holding tau_v
+  std::vector<std::string> emission_channels;  // image: per scene band, "" = none
+  int nx = 1024, nr = 512;         // synthetic: texels along the axis and radially
+  double length_pc = 2.0;          // the map's length along the axis; texel = length_pc / nx
+  double tau_scale = 1.0;          // multiplies tau_v
+  double emission_scale = 1.0;     // multiplies emission (0: none)
+  Vec3 origin{0, 0, 0};            // the axis point where the map starts (x = 0)
+  Vec3 axis{0, 0, 1};              // unit direction of +x
+  std::string skip = "omega_multi";
+  double step_texels = 0.5;        // the march's step h in texels
+};
+
 struct Scene {
   std::string path;  // the scene file as given ("demo" for demo_scene())
   std::vector<std::string> bands{"B", "V", "R"};
-  DensityGrid density;  // tau_v per voxel
+  DensityGrid density;  // tau_v per voxel (empty for an axial scene)
+  std::optional<AxialSpec> axial;  // set instead of a density grid
   // Empty, or one grid per band (bands order) with the density's shape: the
   // radiance j a ray gains crossing the voxel along one voxel edge
   // (L_sun pc^-2 sr^-1; DESIGN.md section 3).

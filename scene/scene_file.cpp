@@ -58,8 +58,11 @@ const char* type_name(const toml::node& n) {
 
 // The keys of every table in a scene file.
 const std::initializer_list<std::string_view> kTopKeys = {"bands",  "density", "emission", "dust",
-                                                          "stars",  "camera",  "output", "render"};
+                                                          "stars",  "camera",  "output", "render", "axial"};
 const std::initializer_list<std::string_view> kRenderKeys = {"levels"};
+const std::initializer_list<std::string_view> kAxialKeys = {
+    "synthetic", "file", "image", "dataset", "emission_prefix", "tau_channel", "emission_channels", "nx", "nr",
+    "length_pc", "tau_scale", "emission_scale", "origin", "axis", "skip", "step_texels"};
 const std::initializer_list<std::string_view> kDensityKeys = {
     "file", "dataset", "fits", "voxel_size_pc", "procedural", "scale"};
 const std::initializer_list<std::string_view> kProceduralKeys = {
@@ -220,6 +223,7 @@ class Parser {
 
   std::vector<std::string> parse_bands(const toml::table& root) const;
   DensityPlan parse_density(const toml::table& root) const;
+  AxialSpec parse_axial(const toml::table& root, const std::vector<std::string>& bands) const;
   ProceduralParams parse_procedural(const toml::table& t, const std::string& key) const;
   std::optional<EmissionPlan> parse_emission(const toml::table& root) const;
   DustParams parse_dust(const toml::table& root, const std::vector<std::string>& bands) const;
@@ -416,6 +420,92 @@ DensityPlan Parser::parse_density(const toml::table& root) const {
   return plan;
 }
 
+AxialSpec Parser::parse_axial(const toml::table& root, const std::vector<std::string>& bands) const {
+  const toml::table& t = table_at(*root.get("axial"), "axial");
+  known_keys(t, "axial", kAxialKeys);
+  std::vector<std::string> given;
+  for (const char* source : {"synthetic", "file", "image"})
+    if (t.get(source) != nullptr) given.push_back(source);
+  if (given.empty()) fail("axial", "give one of synthetic (a built-in map), file (HDF5) or image");
+  if (given.size() > 1)
+    fail("axial." + given[1], "conflicts with axial." + given[0] + ": give exactly one of synthetic, file or image");
+  AxialSpec a;
+  a.source = given[0];
+  auto only = [&](const char* key, const char* source) {
+    if (t.get(key) != nullptr && a.source != source)
+      fail(std::string("axial.") + key, std::string("applies to axial.") + source + " only");
+  };
+  only("dataset", "file");
+  only("emission_prefix", "file");
+  only("tau_channel", "image");
+  only("emission_channels", "image");
+  only("nx", "synthetic");
+  only("nr", "synthetic");
+  if (a.source == "synthetic") {
+    a.synthetic = string(*t.get("synthetic"), "axial.synthetic");
+    const char* names[] = {"bipolar", "lopsided", "shells", "empty", "full"};
+    if (std::find_if(std::begin(names), std::end(names), [&](const char* n) { return a.synthetic == n; }) ==
+        std::end(names))
+      fail("axial.synthetic", "'" + a.synthetic + "' is not a built-in map (known: bipolar, lopsided, shells, empty, full)");
+    for (const char* key : {"nx", "nr"})
+      if (const toml::node* v = t.get(key)) {
+        const int n = small_integer(*v, std::string("axial.") + key);
+        if (n < 2 || n > 65536) fail(std::string("axial.") + key, "is " + std::to_string(n) + "; must be 2 to 65536");
+        (std::string(key) == "nx" ? a.nx : a.nr) = n;
+      }
+  } else {
+    a.path = data_path(*t.get(a.source), "axial." + a.source);
+    std::ifstream probe(a.path, std::ios::binary);
+    if (!probe || fs::is_directory(a.path)) fail("axial." + a.source, "cannot read '" + a.path + "'");
+  }
+  if (const toml::node* v = t.get("dataset")) {
+    a.dataset = string(*v, "axial.dataset");
+    if (a.dataset.empty()) fail("axial.dataset", "must not be empty");
+  }
+  if (const toml::node* v = t.get("emission_prefix")) a.emission_prefix = string(*v, "axial.emission_prefix");
+  if (const toml::node* v = t.get("tau_channel")) {
+    a.tau_channel = string(*v, "axial.tau_channel");
+    if (a.tau_channel.empty()) fail("axial.tau_channel", "must name a channel");
+  }
+  if (const toml::node* v = t.get("emission_channels")) {
+    const toml::table& ch = table_at(*v, "axial.emission_channels");
+    a.emission_channels.assign(bands.size(), "");
+    for (auto&& [k, value] : ch) {
+      const std::string band(k.str());
+      const auto at = std::find(bands.begin(), bands.end(), band);
+      if (at == bands.end())
+        fail("axial.emission_channels." + band, "unknown band (the scene's bands: " + band_list(bands) + ")");
+      a.emission_channels[size_t(at - bands.begin())] = string(value, "axial.emission_channels." + band);
+    }
+  }
+  auto positive = [&](const char* key, double& out, bool zero_ok) {
+    if (const toml::node* v = t.get(key)) {
+      out = number(*v, std::string("axial.") + key);
+      if (!(out > 0 || (zero_ok && out == 0)))
+        fail(std::string("axial.") + key, "is " + number_text(out) + (zero_ok ? "; must be >= 0" : "; must be > 0"));
+    }
+  };
+  positive("length_pc", a.length_pc, false);
+  positive("tau_scale", a.tau_scale, false);
+  positive("emission_scale", a.emission_scale, true);
+  positive("step_texels", a.step_texels, false);
+  if (a.step_texels < 1e-3) fail("axial.step_texels", "is " + number_text(a.step_texels) + "; must be at least 1e-3");
+  if (const toml::node* v = t.get("origin")) a.origin = vec3(*v, "axial.origin");
+  if (const toml::node* v = t.get("axis")) {
+    const Vec3 d = vec3(*v, "axial.axis");
+    const double n = std::sqrt(double(d.x) * d.x + double(d.y) * d.y + double(d.z) * d.z);
+    if (!(n > 1e-12)) fail("axial.axis", "must not be zero (a direction)");
+    a.axis = Vec3{float(d.x / n), float(d.y / n), float(d.z / n)};
+  }
+  if (const toml::node* v = t.get("skip")) {
+    a.skip = string(*v, "axial.skip");
+    const char* modes[] = {"naive", "empty", "global_max", "omega", "omega_multi"};
+    if (std::find_if(std::begin(modes), std::end(modes), [&](const char* m) { return a.skip == m; }) == std::end(modes))
+      fail("axial.skip", "'" + a.skip + "' is not a skip mode (known: naive, empty, global_max, omega, omega_multi)");
+  }
+  return a;
+}
+
 std::optional<EmissionPlan> Parser::parse_emission(const toml::table& root) const {
   const toml::node* n = root.get("emission");
   if (n == nullptr) return std::nullopt;
@@ -610,17 +700,41 @@ Scene Parser::build(toml::table& root) {
   Scene scene;
   scene.path = name_;
   scene.bands = parse_bands(root);
-  const DensityPlan density = parse_density(root);
-  const std::optional<EmissionPlan> emission = parse_emission(root);
+  const bool axial = root.get("axial") != nullptr;
+  if (axial && root.get("density") != nullptr)
+    fail("axial", "conflicts with [density]: a scene is either a 3D grid or an axial map");
+  if (axial && root.get("emission") != nullptr)
+    fail("emission", "applies to [density] grids; an axial map carries its own emission (axial.emission_prefix, "
+                     "axial.emission_channels)");
+  DensityPlan density;
+  if (axial) {
+    density.kind = DensityKind::Hdf5;  // stars need an explicit position
+    scene.axial = parse_axial(root, scene.bands);
+  } else {
+    density = parse_density(root);
+  }
+  const std::optional<EmissionPlan> emission = axial ? std::nullopt : parse_emission(root);
   scene.dust = parse_dust(root, scene.bands);
   scene.stars = parse_stars(root, density);
-  if (scene.stars.empty() && !emission)
+  if (scene.stars.empty() && !emission && !axial)
     fail("stars", "missing: a scene needs at least one [[stars]] entry (or an [emission] grid)");
+  if (axial) {
+    // Stars on the axis keep the illumination axisymmetric (DESIGN.md section 3).
+    const AxialSpec& a = *scene.axial;
+    for (size_t i = 0; i < scene.stars.size(); ++i) {
+      const Vec3 q = scene.stars[i].position - a.origin;
+      const Vec3 off = q - dot(q, a.axis) * a.axis;
+      if (!(length(off) <= 1e-6 * (a.length_pc + length(q))))
+        fail("stars." + std::to_string(i) + ".position",
+             "is " + number_text(length(off)) + " pc from the axial map's axis; stars of an axial scene must lie on "
+             "its axis (axial.origin + s * axial.axis)");
+    }
+  }
   scene.camera = parse_camera(root);
   parse_output(root, scene);
   parse_render(root, scene);
   if (const auto issue = scene_detail::settings_issue(scene)) fail(issue->key, issue->reason);
-  load_grids(density, emission, scene);  // the expensive part, last
+  if (!axial) load_grids(density, emission, scene);  // the expensive part, last
   if (const auto issue = scene_detail::grids_issue(scene)) fail(issue->key, issue->reason);
   return scene;
 }

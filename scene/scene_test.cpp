@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "illumination/star.h"
+#include "scene/density_sources.h"
 #include "scene/test_files.h"
 
 namespace nebula {
@@ -546,6 +547,97 @@ TEST_F(SceneFile, RenderLevelsIsReadAndChecked) {
   refused("negative", std::string(kBase) + "[render]\nlevels = -1\n", {"render.levels", "0..16"});
   refused("float", std::string(kBase) + "[render]\nlevels = 1.5\n", {"render.levels", "integer"});
   refused("unknown", std::string(kBase) + "[render]\nstep = 1\n", {"render.step"});
+}
+
+const char* kAxial = R"(
+[axial]
+synthetic = "shells"
+nx = 64
+nr = 32
+length_pc = 2.0
+origin = [0.0, 0.0, -1.0]
+axis = [0.0, 0.0, 2.0]
+
+[[stars]]
+position = [0.0, 0.0, 0.5]
+luminosity_lsun = 100
+class = "B5V"
+
+[camera]
+position = [4.0, 0.0, 0.0]
+look_at = [0.0, 0.0, 0.0]
+)";
+
+std::string axial_edited(const std::string& from, const std::string& to) {
+  std::string text = kAxial;
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+class AxialSceneFile : public testing::TempDirTest {
+ protected:
+  void refused(const std::string& name, const std::string& text, std::vector<std::string> pieces,
+               const std::vector<std::string>& overrides = {}) {
+    const std::string file = write_text(name + ".toml", text);
+    pieces.insert(pieces.begin(), name + ".toml");
+    SCOPED_TRACE(name);
+    testing::expect_error([&] { load_scene(file, overrides); }, pieces);
+  }
+};
+
+TEST_F(AxialSceneFile, LoadsWithDefaultsAndANormalisedAxis) {
+  const Scene s = load_scene(write_text("axial.toml", kAxial));
+  ASSERT_TRUE(s.axial.has_value());
+  EXPECT_EQ(s.axial->source, "synthetic");
+  EXPECT_EQ(s.axial->synthetic, "shells");
+  EXPECT_EQ(s.axial->nx, 64);
+  EXPECT_EQ(s.axial->nr, 32);
+  EXPECT_FLOAT_EQ(s.axial->axis.z, 1.0f);
+  EXPECT_EQ(s.axial->skip, "omega_multi");
+  EXPECT_EQ(s.axial->step_texels, 0.5);
+  EXPECT_EQ(s.density.tau_v.size(), 0u);
+  EXPECT_NO_THROW(validate_scene(s));
+  const Scene naive = load_scene(path("axial.toml"), {"axial.skip=naive"});
+  EXPECT_EQ(naive.axial->skip, "naive");
+}
+
+TEST_F(AxialSceneFile, HdfMapFileIsResolvedAndChecked) {
+  testing::H5Dataset set;
+  set.name = "tau_v";
+  set.dims = {4, 8};  // [nr][nx]
+  set.values.assign(32, 0.1);
+  testing::write_h5(path("maps/m.h5"), {set});
+  const Scene s = load_scene(write_text("f.toml", axial_edited("synthetic = \"shells\"\nnx = 64\nnr = 32",
+                                                               "file = \"maps/m.h5\"")));
+  EXPECT_EQ(s.axial->source, "file");
+  int nx = 0, nr = 0;
+  const std::vector<float> tau = load_axial_plane_hdf5(s.axial->path, "tau_v", nx, nr);
+  EXPECT_EQ(nx, 8);
+  EXPECT_EQ(nr, 4);
+  EXPECT_EQ(tau.size(), 32u);
+  set.dims = {2, 4, 4};
+  set.values.assign(32, 0.1);
+  testing::write_h5(path("maps/cube.h5"), {set});
+  testing::expect_error([&] { load_axial_plane_hdf5(path("maps/cube.h5"), "tau_v", nx, nr); },
+                        {"cube.h5", "tau_v", "must be 2-D [nr][nx], found 3-D"});
+}
+
+TEST_F(AxialSceneFile, RefusesBadKeys) {
+  refused("density", std::string(kAxial) + "[density]\nprocedural = {}\n", {"axial", "conflicts with [density]"});
+  refused("unknown", axial_edited("nx = 64", "nx = 64\nradius = 3"), {"axial.radius", "unknown key"});
+  refused("name", axial_edited("\"shells\"", "\"spiral\""), {"axial.synthetic", "'spiral'", "bipolar"});
+  refused("two", axial_edited("nx = 64", "nx = 64\nfile = \"x.h5\""), {"axial.file", "conflicts with axial.synthetic"});
+  refused("skip", axial_edited("nx = 64", "nx = 64\nskip = \"fast\""), {"axial.skip", "'fast'", "omega_multi"});
+  refused("step", axial_edited("nx = 64", "nx = 64\nstep_texels = 0"), {"axial.step_texels", "must be > 0"});
+  refused("axis", axial_edited("[0.0, 0.0, 2.0]", "[0.0, 0.0, 0.0]"), {"axial.axis", "must not be zero"});
+  refused("off", axial_edited("[0.0, 0.0, 0.5]", "[0.1, 0.0, 0.5]"), {"stars.0.position", "from the axial map's axis"});
+  refused("nx", axial_edited("nx = 64", "nx = 1"), {"axial.nx", "must be 2 to 65536"});
+  refused("dataset", axial_edited("nx = 64", "nx = 64\ndataset = \"d\""), {"axial.dataset", "applies to axial.file only"});
+  refused("missing", axial_edited("synthetic = \"shells\"\nnx = 64\nnr = 32", "file = \"none.h5\""),
+          {"axial.file", "cannot read"});
+  refused("override", kAxial, {"axial.step_texels", "override"}, {"axial.step_texels=-1"});
 }
 
 }  // namespace

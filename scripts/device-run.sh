@@ -11,7 +11,7 @@ mkdir -p "$OUT"
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm,memory.total --format=csv | tee "$OUT/gpu.txt"
 {
   for t in "$B"/bin/*_gpu_tests; do "$t" --gtest_brief=1 || echo "FAILED: $t"; done
-  for t in core_tests montecarlo_tests tables_tests illumination_tests raycast_tests; do "$B/bin/$t" --gtest_brief=1 || echo "FAILED: $t"; done
+  for t in core_tests montecarlo_tests tables_tests illumination_tests raycast_tests axial_tests; do "$B/bin/$t" --gtest_brief=1 || echo "FAILED: $t"; done
 } 2>&1 | tee "$OUT/tests.log"
 "$B/bin/nebula" validate montecarlo --backend cuda --effort 4 2>&1 | tee "$OUT/validate.log"
 "$B/bin/nebula" tabulate --backend cuda -q --photons 1e6 -o "$OUT/table_a0.6_g0.6.h5" 2>&1 | tee "$OUT/tabulate.log"
@@ -19,4 +19,7 @@ nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm,memory.total 
 "$B/bin/nebula" bench tabulate --backend both --repeats 5 2>&1 | tee "$OUT/bench.log"
 "$B/bin/nebula" bench bake --backend both --size 256 --stars 4 2>&1 | tee "$OUT/bench_bake.log"
 "$B/bin/nebula" bench render --backend both --size 256 --stars 8 2>&1 | tee "$OUT/bench_render.log"
+"$B/bin/nebula" bench axial --backend cuda 2>&1 | tee "$OUT/bench_axial.log"
+"$B/bin/nebula" bench axial --backend cuda --emission-only 2>&1 | tee "$OUT/bench_axial_emission_only.log"
+"$B/bin/nebula" bench axial --backend cuda --maps full --no-step-aside 2>&1 | tee "$OUT/bench_axial_full_no_step_aside.log"
 "$B/bin/nebula" render --demo --backend cuda --force -o "$OUT/demo.h5" 2>&1 | tee "$OUT/render_demo.log"

@@ -4,8 +4,10 @@
 #include <cmath>
 
 #include "core/philox.h"
+#include "illumination/axial_bake.h"
 #include "illumination/optical_depth_bake.h"
 #include "raycast/pyramid_render.h"
+#include "raycast/axial_renderer.h"
 #include "raycast/renderer.h"
 #include "scene/density_sources.h"
 #include "tables/scattering_table.h"
@@ -254,6 +256,89 @@ TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int 
   row.spp_per_second = spp / row.median_seconds;
   row.vertices_per_path = out.paths ? double(out.counters.vertices) / out.paths : 0;
   return row;
+}
+
+void bench_axial(Backend backend, int map_size, int width, int height, int repeats, float step_texels,
+                 const std::vector<std::string>& maps, const std::vector<int>& inclinations, bool star,
+                 const std::function<void(const AxialBenchRow&)>& on_row, bool step_aside) {
+  ScatteringTable table;
+  if (star) {
+    TabulateParams tp;
+    tp.photons_per_row = 2000;  // the table's values do not change the timing
+    tp.binning = AngularBinning::UniformTheta;
+    const Tabulation tab = tabulate(tp, backend);
+    table = ScatteringTable::make_axes(tp.tau_max, tp.tau_bins, tp.binning, tp.mu_bins);
+    for (size_t e = 0; e < tab.P.size(); ++e) table.P[e] = static_cast<float>(tab.P[e]);
+  }
+  const float texel = 1.0f / map_size;
+  for (const std::string& name : maps) {
+    AxialMap map = synthetic_axial_map(name, map_size, map_size, texel, 3, 2.0f);
+    map.origin = {0, 0, -0.5f};
+    map.axis = {0, 0, 1};
+    const Vec3 centre{0, 0, 0};
+    std::vector<std::vector<float>> depth;
+    AxialRenderInputs in;
+    in.map = &map;
+    const float ratios[3] = {1.2f, 1.0f, 0.85f};
+    for (int b = 0; b < 3; ++b)
+      in.bands.push_back(AxialRenderBand{std::string(1, "BVR"[b]), ratios[b], star ? 0.6f : 0.0f, star ? &table : nullptr});
+    if (star) {
+      depth = bake_axial_star_depths(map.nx, map.nr, map.texel, map.tau_v, {0.5f}, backend).tau_v;
+      in.stars.push_back(AxialRenderStar{centre, {1.0f, 1.0f, 1.0f}, &depth[0]});
+    }
+    in.step = step_texels * texel;
+    in.step_aside = step_aside;
+    for (int inc : inclinations) {
+      const double i = inc * kPiD / 180.0;
+      CameraSettings cs;
+      cs.projection = Projection::Orthographic;
+      const Vec3 from{float(std::sin(i)), 0.0f, float(std::cos(i))};
+      cs.position = centre + 4.0f * from;
+      cs.look_at = centre;
+      cs.up = inc == 0 ? Vec3{0, 1, 0} : Vec3{0, 0, 1};
+      // The map's silhouette: a 1 x 2 rectangle seen at inclination i.
+      cs.ortho_width = 2.05;
+      cs.width = width;
+      cs.height = height;
+      in.camera = make_camera(cs);
+      Image naive;
+      double naive_ms = 0;
+      for (AxialSkip mode : {AxialSkip::Naive, AxialSkip::Empty, AxialSkip::GlobalMax, AxialSkip::Omega,
+                             AxialSkip::OmegaMulti}) {
+        in.skip = mode;
+        AxialRenderStats stats;
+        Image image = render_axial(in, backend, &stats);  // warm-up
+        std::vector<double> times;
+        for (int r = 0; r < repeats; ++r) {
+          image = render_axial(in, backend, &stats);
+          times.push_back(stats.seconds);
+        }
+        AxialBenchRow row;
+        row.backend = to_string(backend);
+        row.map = name;
+        row.mode = to_string(mode);
+        row.map_size = map_size;
+        row.width = width;
+        row.height = height;
+        row.inclination_deg = inc;
+        row.median_ms = 1e3 * median_of(times);
+        row.samples = stats.samples;
+        row.ran = to_string(stats.skip_used);
+        if (mode == AxialSkip::Naive) {
+          naive = image;
+          naive_ms = row.median_ms;
+        }
+        row.speedup = naive_ms / row.median_ms;
+        double peak = 0, worst = 0;
+        for (size_t p = 0; p < image.pixels.size(); ++p) {
+          peak = std::max(peak, double(std::fabs(naive.pixels[p])));
+          worst = std::max(worst, double(std::fabs(image.pixels[p] - naive.pixels[p])));
+        }
+        row.max_difference = peak > 0 ? worst / peak : worst;
+        on_row(row);
+      }
+    }
+  }
 }
 
 }  // namespace nebula

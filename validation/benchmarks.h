@@ -100,3 +100,32 @@ TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int 
                           bool exact_transmittance = false, bool equiangular = false);
 
 }  // namespace nebula
+
+#include <functional>
+
+namespace nebula {
+
+struct AxialBenchRow {
+  std::string backend, map, mode;
+  std::string ran;            // the mode that ran: naive when the map has no empty texel (step aside)
+  int map_size = 0, width = 0, height = 0, inclination_deg = 0;
+  double median_ms = 0;       // marching only (CUDA events on the GPU), median of the repeats
+  double speedup = 0;         // naive's median / this mode's
+  double max_difference = 0;  // largest |pixel - naive pixel| over naive's peak (0: bit-identical)
+  uint64_t samples = 0;       // samples the rays stepped through (CPU only; 0 on the GPU)
+};
+
+// The thesis' Tables 5.1-5.5 (Khalass 2021): each synthetic map of
+// map_size x map_size texels (1 pc along the axis), seen by an orthographic
+// camera of width x height pixels framing the map at each inclination,
+// rendered in every skip mode (naive first) at a step of step_texels; one
+// warm-up, then the median of `repeats`. With `star`, a B-type star on the
+// axis at the map's centre lights the dust (full physics, a = g = 0.6, three
+// bands); without it, emission-absorption only. Rows go to on_row as they come.
+// step_aside false runs the skip code even on maps without empty texels (to
+// measure its overhead there).
+void bench_axial(Backend backend, int map_size, int width, int height, int repeats, float step_texels,
+                 const std::vector<std::string>& maps, const std::vector<int>& inclinations, bool star,
+                 const std::function<void(const AxialBenchRow&)>& on_row, bool step_aside = true);
+
+}  // namespace nebula

@@ -1,0 +1,329 @@
+#pragma once
+// The fixed-step marcher through an axial map (raycast/AXIAL.md), written once
+// for host and device: the naive march ("NASR" in Khalass 2021) and four
+// exact empty-space skipping modes that only ever leave out samples that are
+// provably empty.
+//
+// Samples. The ray is clipped to the map's cylinder {0 <= x <= L, r <= R}
+// (L = nx l, R = nr l); sample k covers [t_in + k h, t_in + (k + 1) h] (the
+// last one ends at t_out), is taken at the middle of its chord and reads the
+// texel holding it (nearest texel: ix = floor(x / l), ir = floor(r / l)). The
+// sample grid depends only on the ray and the map's outer cylinder, never on
+// the skipping mode.
+//
+// Exactness. An empty sample adds T * 0 to the radiance and multiplies T by
+// exp(-0) = 1: exact no-ops in floating point. A skip advances by a whole
+// number of samples over a stretch of ray shown (with a margin far above
+// float rounding) to lie above the height map, so every skipping mode visits
+// the same non-empty samples in the same order with the same arithmetic as
+// the naive march: the images are bit-identical on one backend.
+#include <cfloat>
+#include <cmath>
+
+#include "core/hd.h"
+#include "core/vec3.h"
+#include "illumination/optical_depth_bake.h"
+#include "raycast/axial_map.h"
+#include "raycast/ray_march.h"
+#include "tables/table_lookup.h"
+
+namespace nebula {
+
+// Ordered: each mode does everything the previous one does.
+enum class AxialSkip : int {
+  Naive = 0,      // every sample: texel fetch and shading
+  Empty = 1,      // the height and floor maps decide a sample is empty before any texel fetch
+  GlobalMax = 2,  // ... and only the samples inside the cylinder of radius H l are visited
+  Omega = 3,      // ... and from an empty sample, jump omega_max (the rest) or omega_large = omega_max / 32
+  OmegaMulti = 4  // ... adaptive jumps (doubling on success, halving on failure), range maxima from the max-tree
+};
+
+const char* to_string(AxialSkip mode);
+
+struct AxialStarView {
+  Vec3 position;             // on the axis
+  float power[kMaxBands];    // band luminosity, L_sun
+  const float* depth_v;      // baked V-band depth to each texel's voxel sphere [ir * nx + ix]
+};
+
+struct AxialMarchScene {
+  AxialView map;
+  int n_bands = 0;
+  float extinction_ratio[kMaxBands];
+  float albedo[kMaxBands];
+  TableView table[kMaxBands];
+  const AxialStarView* stars = nullptr;
+  int n_stars = 0;
+  float step = 1.0f;  // h, world units
+  AxialSkip skip = AxialSkip::OmegaMulti;
+  float min_transmittance = 1e-4f;
+};
+
+// The ray in the map's frame: x(t) = x0 + t dx along the axis, and the part
+// perpendicular to the axis w(t) = w0 + t wd, r(t) = |w(t)|.
+struct AxialRay {
+  float x0, dx;
+  Vec3 w0, wd;
+};
+
+NEBULA_HD AxialRay axial_ray(const AxialView& m, Vec3 origin, Vec3 dir) {
+  AxialRay r;
+  const Vec3 q = origin - m.origin;
+  r.x0 = dot(q, m.axis);
+  r.dx = dot(dir, m.axis);
+  r.w0 = q - r.x0 * m.axis;
+  r.wd = dir - r.dx * m.axis;
+  return r;
+}
+
+// The ray's parameter interval [t0, t1] (t >= 0) inside the finite cylinder
+// {x_lo <= x <= x_hi, r <= radius}; false when it misses (or only touches).
+// Robust for rays parallel to the axis (|wd| = 0: inside iff r(0) <= radius),
+// rays through the axis, grazing rays (a tiny or empty interval, never NaN)
+// and origins inside (t0 = 0). Double precision: once or twice per ray.
+NEBULA_HD bool intersect_cylinder(const AxialRay& ray, float x_lo, float x_hi, float radius, float& t0, float& t1) {
+  double lo = 0.0, hi = 1e30;
+  if (ray.dx == 0.0f) {
+    if (!(ray.x0 >= x_lo && ray.x0 <= x_hi)) return false;
+  } else {
+    double ta = (double(x_lo) - ray.x0) / ray.dx, tb = (double(x_hi) - ray.x0) / ray.dx;
+    if (ta > tb) {
+      const double s = ta;
+      ta = tb;
+      tb = s;
+    }
+    lo = ta > lo ? ta : lo;
+    hi = tb < hi ? tb : hi;
+  }
+  const double A = double(ray.wd.x) * ray.wd.x + double(ray.wd.y) * ray.wd.y + double(ray.wd.z) * ray.wd.z;
+  const double B = double(ray.w0.x) * ray.wd.x + double(ray.w0.y) * ray.wd.y + double(ray.w0.z) * ray.wd.z;
+  const double C = double(ray.w0.x) * ray.w0.x + double(ray.w0.y) * ray.w0.y + double(ray.w0.z) * ray.w0.z;
+  const double c = C - double(radius) * radius;
+  if (A < 1e-14) {  // parallel to the axis (|wd| < 1e-7): r does not change along the ray
+    if (c > 0.0) return false;
+  } else {
+    const double disc = B * B - A * c;
+    if (!(disc >= 0.0)) return false;
+    const double s = sqrt(disc);
+    const double q = -(B + (B < 0.0 ? -s : s));  // no cancellation: |q| >= s
+    double ra, rb;
+    if (q == 0.0) {  // B = 0 and disc = 0: touches at t = 0
+      ra = rb = 0.0;
+    } else {
+      ra = q / A;
+      rb = c / q;
+    }
+    if (ra > rb) {
+      const double t = ra;
+      ra = rb;
+      rb = t;
+    }
+    lo = ra > lo ? ra : lo;
+    hi = rb < hi ? rb : hi;
+  }
+  if (!(lo < hi)) return false;
+  t0 = static_cast<float>(lo);
+  t1 = static_cast<float>(hi);
+  return t0 < t1;
+}
+
+namespace axial_detail {
+
+// Smallest r over t in [ta, tb] (r is convex in t: |w0 + t wd|), as an
+// evaluation of |w(t)| at the clamped vertex, so no cancellation.
+NEBULA_HD float min_radius(const AxialRay& ray, float ta, float tb) {
+  const float A = dot(ray.wd, ray.wd);
+  float t = A > 0.0f ? -dot(ray.w0, ray.wd) / A : ta;
+  t = t < ta ? ta : (t > tb ? tb : t);
+  return length(ray.w0 + t * ray.wd);
+}
+
+// Whether every point of the ray with t in [ta, tb], grown by eps on every
+// side, lies above the height map or below the floor map of the columns it
+// crosses: then every sample there is empty.
+template <bool kTree>
+NEBULA_HD bool stretch_is_empty(const AxialView& m, const AxialRay& ray, float ta, float tb, float eps) {
+  ta -= eps;
+  tb += eps;
+  const float xa = ray.x0 + ta * ray.dx, xb = ray.x0 + tb * ray.dx;
+  const float x_min = fminf(xa, xb) - eps, x_max = fmaxf(xa, xb) + eps;
+  if (x_max < 0.0f || x_min >= m.length()) return true;
+  const float inv = 1.0f / m.texel;
+  const float lo_f = fmaxf(floorf(x_min * inv), 0.0f), hi_f = fminf(floorf(x_max * inv), float(m.nx - 1));
+  const int lo = static_cast<int>(lo_f), hi = static_cast<int>(hi_f);
+  // r is convex along the ray: smallest at the clamped vertex, largest at an end.
+  const float r_min = min_radius(ray, ta, tb);
+  const float r_max = fmaxf(length(ray.w0 + ta * ray.wd), length(ray.w0 + tb * ray.wd));
+  if (kTree) {
+    const int h = m.range_max_tree(lo, hi);
+    if (h == 0 || r_min >= h * m.texel + eps) return true;
+    return r_max + eps <= m.range_min_floor(lo, hi) * m.texel;
+  }
+  // The scan stops as soon as neither holds.
+  bool above = true, below = true;
+  for (int i = lo; i <= hi; ++i) {
+    if (m.height[i] == 0) continue;  // an empty column
+    above = above && r_min >= m.height[i] * m.texel + eps;
+    below = below && r_max + eps <= m.floor[i] * m.texel;
+    if (!above && !below) return false;
+  }
+  return true;
+}
+
+}  // namespace axial_detail
+
+// One ray through the axial map: radiance and transmittance per band.
+// `visited` (may be null) counts the samples the loop stepped through.
+NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 dir, int* visited = nullptr) {
+  RayResult out{};
+  for (int b = 0; b < kMaxBands; ++b) out.transmittance[b] = 1.0f;
+  const AxialView& m = s.map;
+  const AxialRay ray = axial_ray(m, origin, dir);
+  float t_in, t_out;
+  if (!intersect_cylinder(ray, 0.0f, m.length(), m.radius(), t_in, t_out)) return out;
+  const float h = s.step;
+  const float span = t_out - t_in;
+  const float n_samples = ceilf(span / h);
+  if (!(n_samples >= 1.0f) || n_samples > 1e8f) return out;  // NaN guard; validate() bounds the step
+  const int K = static_cast<int>(n_samples);
+  int k_begin = 0, k_end = K;
+  // Geometric margin for skip decisions: far above the rounding of the
+  // sample positions (a few ulps of the coordinates' magnitude).
+  const float scale = length(origin - m.origin) + t_out + m.length() + m.radius();
+  const float eps = 1e-3f * m.texel + 1e-5f * scale;
+  const int skip = static_cast<int>(s.skip);
+  if (skip >= int(AxialSkip::GlobalMax)) {
+    if (m.global_max == 0) return out;
+    float ta, tb;
+    if (!intersect_cylinder(ray, -eps, m.length() + eps, m.global_max * m.texel + eps, ta, tb)) return out;
+    // Samples whose positions t_in + (k + 1/2) h lie before ta or after tb are empty.
+    const float first = floorf((ta - t_in) / h - 0.5f) - 1.0f, last = ceilf((tb - t_in) / h - 0.5f) + 1.0f;
+    k_begin = first > 0.0f ? static_cast<int>(fminf(first, n_samples)) : 0;
+    k_end = last < n_samples - 1.0f ? static_cast<int>(fmaxf(last, 0.0f)) + 1 : K;
+  }
+  const int omega_large = (k_end - k_begin) / 32;
+  const float inv_texel = 1.0f / m.texel;
+  const Vec3 to_eye = -dir;
+  bool previous_empty = false;
+  int stride = 2;  // omega_multi's next jump, in samples
+  int wait = 0, backoff = 1;  // empty samples to pass before the next attempt
+  // The texel a run of samples is in and the transmittance where the ray
+  // entered it: every sample in the run is seen through that (the texel plays
+  // the voxel's part: P holds the extinction inside it).
+  long long run_cell = -1;
+  float t_entry[kMaxBands];
+  for (int b = 0; b < kMaxBands; ++b) t_entry[b] = 1.0f;
+  for (int k = k_begin; k < k_end; ++k) {
+    if (visited) ++*visited;
+    float chord = h, t = t_in + (float(k) + 0.5f) * h;
+    if (k == K - 1) {
+      chord = fmaxf(span - float(K - 1) * h, 0.0f);  // never negative, whatever ceil's rounding
+      t = t_in + float(K - 1) * h + 0.5f * chord;
+    }
+    const Vec3 pos = origin + t * dir;
+    const Vec3 q = pos - m.origin;
+    const float x = dot(q, m.axis);
+    const float r = length(q - x * m.axis);
+    const float fx = floorf(x * inv_texel), fr = floorf(r * inv_texel);
+    bool empty = !(fx >= 0.0f && fx < float(m.nx) && fr < float(m.nr));  // outside (or NaN)
+    const int ix = empty ? 0 : static_cast<int>(fx), ir = empty ? 0 : static_cast<int>(fr);
+    if (!empty && skip >= int(AxialSkip::Empty)) empty = ir >= m.height[ix] || ir < m.floor[ix];
+    if (skip == int(AxialSkip::Naive) || !empty) {
+      float tau_v = 0.0f;
+      float source[kMaxBands] = {};
+      bool dark = true;
+      if (!empty) {
+        const size_t cell = m.index(ix, ir);
+        tau_v = m.tau_v[cell];
+        for (int b = 0; b < s.n_bands; ++b) {
+          source[b] = m.emission[b] ? m.emission[b][cell] : 0.0f;
+          dark = dark && source[b] == 0.0f;
+        }
+        dark = dark && tau_v == 0.0f;
+        if (tau_v > 0.0f) {
+          for (int k_star = 0; k_star < s.n_stars; ++k_star) {
+            const AxialStarView& star = s.stars[k_star];
+            const Vec3 d = pos - star.position;
+            const float dist = length(d);
+            const float mu = dist > 0.0f ? dot(d, to_eye) / dist : 0.0f;
+            const float depth = star.depth_v[cell];
+            float u = TableView::kNoAngle;
+            int u_from = -1;
+            for (int b = 0; b < s.n_bands; ++b) {
+              if (!(s.albedo[b] > 0.0f)) continue;
+              if (u_from < 0 || s.table[b].bins.kind != s.table[u_from].bins.kind ||
+                  s.table[b].bins.n != s.table[u_from].bins.n) {
+                u = s.table[b].angle_coordinate(mu);
+                u_from = b;
+              }
+              const float tau_b = tau_v * s.extinction_ratio[b];
+              const float e = star_irradiance(star.power[b], dist, m.texel, depth * s.extinction_ratio[b]);
+              source[b] += e * s.table[b].lookup_at(s.albedo[b] * tau_b, u, &out.table_clamps);
+            }
+          }
+        }
+      }
+      empty = empty || dark;
+      // T_in rule (DESIGN.md section 3), the texel in the voxel's part.
+      const long long cell = empty ? -1 : static_cast<long long>(m.index(ix, ir));
+      if (cell != run_cell)
+        for (int b = 0; b < s.n_bands; ++b) t_entry[b] = out.transmittance[b];
+      run_cell = cell;
+      const float fraction = chord * inv_texel;
+      bool visible = false;
+      for (int b = 0; b < s.n_bands; ++b) {
+        out.radiance[b] += t_entry[b] * source[b] * fraction;
+        out.transmittance[b] *= expf(-tau_v * s.extinction_ratio[b] * fraction);
+        visible = visible || out.transmittance[b] >= s.min_transmittance;
+      }
+      if (!visible) break;
+    }
+    if (empty) run_cell = -1;  // also for samples never shaded: the same runs in every mode
+    const bool gap_start = !previous_empty;
+    previous_empty = empty;
+    if (!empty || skip < int(AxialSkip::Omega)) continue;
+    // From an empty sample k: skip samples k+1 .. k+n when the stretch from
+    // sample k's position to sample k+n's is empty. After a failed attempt the
+    // next ones wait (1, 2, 4, ... up to 32 empty samples), so the hollow
+    // parts the maps cannot prove empty cost few queries.
+    const int rest = k_end - 1 - k;
+    if (rest < 2) continue;
+    if (gap_start && (skip == int(AxialSkip::Omega)
+                          ? axial_detail::stretch_is_empty<false>(m, ray, t, t + float(rest) * h, eps)
+                          : axial_detail::stretch_is_empty<true>(m, ray, t, t + float(rest) * h, eps)))
+      break;  // omega_max: the rest of the ray, tried once per run of empty samples
+    if (wait > 0) {
+      --wait;
+      continue;
+    }
+    bool jumped = false;
+    if (skip == int(AxialSkip::Omega)) {
+      // omega_large = omega_max / 32, the columns' maximum scanned.
+      const int n = omega_large < rest ? omega_large : rest;
+      if (n >= 2 && axial_detail::stretch_is_empty<false>(m, ray, t, t + float(n) * h, eps)) {
+        k += n;
+        jumped = true;
+      }
+    } else {
+      // Hierarchical: one adaptive jump, n doubling after each success and
+      // halving after a failure, range extrema from the trees (O(log nx)).
+      const int n = stride < rest ? stride : rest;
+      if (n >= 2 && axial_detail::stretch_is_empty<true>(m, ray, t, t + float(n) * h, eps)) {
+        k += n;
+        stride = 2 * n;
+        jumped = true;
+      } else {
+        stride = n / 2 > 2 ? n / 2 : 2;
+      }
+    }
+    if (jumped) {
+      backoff = 1;
+    } else {
+      wait = backoff;
+      backoff = backoff < 32 ? 2 * backoff : 32;
+    }
+  }
+  return out;
+}
+
+}  // namespace nebula

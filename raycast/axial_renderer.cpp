@@ -1,0 +1,127 @@
+#include "raycast/axial_renderer.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+#include "core/error.h"
+#include "core/progress.h"
+
+namespace nebula {
+
+const char* to_string(AxialSkip mode) {
+  switch (mode) {
+    case AxialSkip::Naive: return "naive";
+    case AxialSkip::Empty: return "empty";
+    case AxialSkip::GlobalMax: return "global_max";
+    case AxialSkip::Omega: return "omega";
+    case AxialSkip::OmegaMulti: return "omega_multi";
+  }
+  return "?";
+}
+
+AxialSkip parse_axial_skip(const std::string& text, const std::string& option) {
+  for (AxialSkip m : {AxialSkip::Naive, AxialSkip::Empty, AxialSkip::GlobalMax, AxialSkip::Omega, AxialSkip::OmegaMulti})
+    if (text == to_string(m)) return m;
+  throw Error(option + ": '" + text + "' is not a skip mode (known: naive, empty, global_max, omega, omega_multi)");
+}
+
+AxialSkip effective_skip(const AxialRenderInputs& in) {
+  return in.step_aside && in.map->empty_texels == 0 ? AxialSkip::Naive : in.skip;
+}
+
+float effective_step(const AxialRenderInputs& in) { return in.step > 0 ? in.step : 0.5f * in.map->texel; }
+
+void validate(const AxialRenderInputs& in) {
+  if (!in.map) throw Error("axial render: no map");
+  const AxialMap& m = *in.map;
+  check_axial_map(m, "axial render: map");
+  if (m.height.size() != size_t(m.nx) || m.level_offset.empty())
+    throw Error("axial render: map: skip structures missing (call update_skip_structures)");
+  if (in.bands.empty() || in.bands.size() > size_t(kMaxBands))
+    throw Error("axial render: 1 to " + std::to_string(kMaxBands) + " bands required");
+  if (!m.emission.empty() && m.emission.size() != in.bands.size())
+    throw Error("axial render: the map has " + std::to_string(m.emission.size()) + " emission planes for " +
+                std::to_string(in.bands.size()) + " bands");
+  if (!(in.step >= 0.0f) || !std::isfinite(in.step)) throw Error("axial render: step must be finite and >= 0");
+  const float h = effective_step(in);
+  const double diagonal = std::hypot(double(m.nx), 2.0 * m.nr) * m.texel;
+  if (diagonal / h > 1e7) throw Error("axial render: step " + to_text(h) + " gives more than 1e7 samples per ray");
+  for (const AxialRenderBand& b : in.bands)
+    if (b.albedo > 0 && !in.stars.empty() && !b.table)
+      throw Error("axial render: band " + b.name + " scatters but has no table");
+  for (size_t k = 0; k < in.stars.size(); ++k) {
+    const AxialRenderStar& s = in.stars[k];
+    if (s.power.size() != in.bands.size()) throw Error("axial render: star " + std::to_string(k) + " lacks band powers");
+    if (!s.depth_v || s.depth_v->size() != m.count())
+      throw Error("axial render: star " + std::to_string(k) + " has no baked depth map");
+    const Vec3 q = s.position - m.origin;
+    const float off = length(q - dot(q, m.axis) * m.axis);
+    if (!(off <= 1e-3f * m.texel))
+      throw Error("axial render: star " + std::to_string(k) + " lies " + to_text(off) +
+                  " from the axis; stars must be on the axis (then their light is axisymmetric)");
+  }
+}
+
+Image render_axial_cpu(const AxialRenderInputs& in, AxialRenderStats* stats) {
+  validate(in);
+  AxialMarchScene scene{};
+  scene.map = in.map->view();
+  scene.n_bands = static_cast<int>(in.bands.size());
+  scene.min_transmittance = in.min_transmittance;
+  scene.step = effective_step(in);
+  scene.skip = effective_skip(in);
+  for (int b = 0; b < scene.n_bands; ++b) {
+    const AxialRenderBand& band = in.bands[size_t(b)];
+    scene.extinction_ratio[b] = band.extinction_ratio;
+    scene.albedo[b] = band.table ? band.albedo : 0.0f;
+    scene.table[b] = band.table ? view_of(*band.table) : TableView{};
+  }
+  std::vector<AxialStarView> stars(in.stars.size());
+  for (size_t k = 0; k < stars.size(); ++k) {
+    stars[k].position = in.stars[k].position;
+    for (int b = 0; b < scene.n_bands; ++b) stars[k].power[b] = in.stars[k].power[size_t(b)];
+    stars[k].depth_v = in.stars[k].depth_v->data();
+  }
+  scene.stars = stars.data();
+  scene.n_stars = static_cast<int>(stars.size());
+
+  std::vector<std::string> names;
+  for (const AxialRenderBand& b : in.bands) names.push_back(b.name);
+  Image image(in.camera.width, in.camera.height, names);
+  std::atomic<uint64_t> clamps{0}, reads{0};
+  const auto start = std::chrono::steady_clock::now();
+  tbb::parallel_for(tbb::blocked_range<int>(0, in.camera.height), [&](const auto& rows) {
+    uint64_t local = 0, local_reads = 0;
+    for (int y = rows.begin(); y != rows.end(); ++y)
+      for (int x = 0; x < in.camera.width; ++x) {
+        Vec3 origin, dir;
+        if (!in.camera.ray(x, y, origin, dir)) continue;
+        int visited = 0;
+        const RayResult r = march_axial_ray(scene, origin, dir, &visited);
+        local_reads += uint64_t(visited);
+        for (int b = 0; b < scene.n_bands; ++b) image.at(b, x, y) = in.exposure * r.radiance[b];
+        local += uint64_t(r.table_clamps);
+      }
+    clamps += local;
+    reads += local_reads;
+    if (in.progress) in.progress->add(rows.size());
+  });
+  if (stats) {
+    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats->table_clamps = clamps;
+    stats->samples = reads;
+    stats->skip_used = scene.skip;
+    stats->device_bytes = in.map->bytes() + in.stars.size() * in.map->count() * sizeof(float);
+  }
+  return image;
+}
+
+Image render_axial(const AxialRenderInputs& in, Backend backend, AxialRenderStats* stats) {
+  return backend == Backend::Cuda ? render_axial_cuda(in, stats) : render_axial_cpu(in, stats);
+}
+
+}  // namespace nebula

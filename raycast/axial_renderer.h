@@ -1,0 +1,66 @@
+#pragma once
+// Renders an axial map (raycast/axial_map.h) lit by stars on its axis, on the
+// CPU (TBB, one task per image row) or the GPU (one CUDA thread per pixel);
+// both run march_axial_ray (axial_march.h).
+#include <string>
+#include <vector>
+
+#include "core/backend.h"
+#include "core/image.h"
+#include "raycast/axial_map.h"
+#include "raycast/axial_march.h"
+#include "raycast/camera.h"
+#include "tables/scattering_table.h"
+
+namespace nebula {
+
+class Progress;
+
+struct AxialRenderBand {
+  std::string name;
+  float extinction_ratio = 1;  // A_b / A_V
+  float albedo = 0.6f;
+  const ScatteringTable* table = nullptr;  // required when albedo > 0 and there are stars
+};
+
+struct AxialRenderStar {
+  Vec3 position;                      // on the map's axis
+  std::vector<float> power;           // per band, L_sun
+  const std::vector<float>* depth_v;  // baked V-band depth per texel (illumination/axial_bake.h)
+};
+
+struct AxialRenderInputs {
+  const AxialMap* map = nullptr;  // emission, if any, per band in the bands' order
+  std::vector<AxialRenderBand> bands;
+  std::vector<AxialRenderStar> stars;
+  Camera camera;
+  float exposure = 1.0f;
+  float min_transmittance = 1e-4f;
+  float step = 0;  // h in world units; 0 means half a texel
+  AxialSkip skip = AxialSkip::OmegaMulti;
+  bool step_aside = true;  // march naively when the map has no empty texel (effective_skip)
+  Progress* progress = nullptr;  // CPU only, advanced in image rows; may be null
+};
+
+struct AxialRenderStats {
+  double seconds = 0;  // marching only (CUDA events on the GPU)
+  uint64_t table_clamps = 0;
+  size_t device_bytes = 0;  // the map, skip structures, depths and tables the march reads
+  uint64_t samples = 0; // samples the rays stepped through (CPU only)
+  AxialSkip skip_used = AxialSkip::Naive;  // effective_skip()
+};
+
+// Throws Error naming the problem (sizes, a star off the axis, a bad step).
+void validate(const AxialRenderInputs& in);
+float effective_step(const AxialRenderInputs& in);
+// The mode the march runs: in.skip, except the naive march when the map has
+// no empty texel (nothing can be skipped, so the checks would only cost).
+AxialSkip effective_skip(const AxialRenderInputs& in);
+// "naive", "empty", "global_max", "omega", "omega_multi"; Error naming `option` otherwise.
+AxialSkip parse_axial_skip(const std::string& text, const std::string& option);
+
+Image render_axial(const AxialRenderInputs& in, Backend backend, AxialRenderStats* stats = nullptr);
+Image render_axial_cpu(const AxialRenderInputs& in, AxialRenderStats* stats);
+Image render_axial_cuda(const AxialRenderInputs& in, AxialRenderStats* stats);
+
+}  // namespace nebula

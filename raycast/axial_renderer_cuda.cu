@@ -1,0 +1,124 @@
+// CUDA launch of the axial marcher: uploads the map, its skip structures, the
+// baked depths and the tables, then one thread per pixel runs the shared
+// march_axial_ray.
+#include <cuda_runtime.h>
+
+#include <memory>
+#include <vector>
+
+#include "core/cuda_check.h"
+#include "core/cuda_timer.h"
+#include "raycast/axial_renderer.h"
+#include "tables/device_table.h"
+
+namespace nebula {
+namespace {
+
+template <class T>
+class DeviceBuffer {
+ public:
+  explicit DeviceBuffer(const std::vector<T>& host) : size_(host.size()) {
+    NEBULA_CUDA_CHECK(cudaMalloc(&ptr_, std::max<size_t>(1, size_) * sizeof(T)));
+    if (size_) NEBULA_CUDA_CHECK(cudaMemcpy(ptr_, host.data(), size_ * sizeof(T), cudaMemcpyHostToDevice));
+  }
+  explicit DeviceBuffer(size_t n) : size_(n) {
+    NEBULA_CUDA_CHECK(cudaMalloc(&ptr_, std::max<size_t>(1, n) * sizeof(T)));
+    NEBULA_CUDA_CHECK(cudaMemset(ptr_, 0, std::max<size_t>(1, n) * sizeof(T)));
+  }
+  ~DeviceBuffer() { cudaFree(ptr_); }
+  DeviceBuffer(const DeviceBuffer&) = delete;
+  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
+  T* get() const { return ptr_; }
+  size_t bytes() const { return size_ * sizeof(T); }
+
+ private:
+  T* ptr_ = nullptr;
+  size_t size_ = 0;
+};
+
+__global__ void axial_kernel(AxialMarchScene scene, Camera camera, float exposure, float* pixels,
+                             unsigned long long* clamps) {
+  const int x = blockIdx.x * blockDim.x + threadIdx.x;
+  const int y = blockIdx.y * blockDim.y + threadIdx.y;
+  if (x >= camera.width || y >= camera.height) return;
+  Vec3 origin, dir;
+  if (!camera.ray(x, y, origin, dir)) return;
+  const RayResult r = march_axial_ray(scene, origin, dir);
+  const size_t plane = size_t(camera.width) * camera.height;
+  for (int b = 0; b < scene.n_bands; ++b) pixels[b * plane + size_t(y) * camera.width + x] = exposure * r.radiance[b];
+  if (r.table_clamps) atomicAdd(clamps, static_cast<unsigned long long>(r.table_clamps));
+}
+
+}  // namespace
+
+Image render_axial_cuda(const AxialRenderInputs& in, AxialRenderStats* stats) {
+  validate(in);
+  const AxialMap& m = *in.map;
+  AxialMarchScene scene{};
+  scene.map = m.view();  // host pointers, replaced below
+  std::vector<std::unique_ptr<DeviceBuffer<float>>> floats;
+  size_t bytes = 0;
+  auto upload = [&](const std::vector<float>& v) {
+    floats.push_back(std::make_unique<DeviceBuffer<float>>(v));
+    bytes += floats.back()->bytes();
+    return floats.back()->get();
+  };
+  scene.map.tau_v = upload(m.tau_v);
+  for (int b = 0; b < kAxialMaxBands; ++b) scene.map.emission[b] = nullptr;
+  for (size_t b = 0; b < m.emission.size(); ++b) scene.map.emission[b] = upload(m.emission[b]);
+  DeviceBuffer<int> height(m.height), floor(m.floor), tree(m.tree), floor_tree(m.floor_tree);
+  bytes += height.bytes() + floor.bytes() + tree.bytes() + floor_tree.bytes();
+  scene.map.height = height.get();
+  scene.map.floor = floor.get();
+  scene.map.tree = tree.get();
+  scene.map.floor_tree = floor_tree.get();
+  scene.n_bands = static_cast<int>(in.bands.size());
+  scene.min_transmittance = in.min_transmittance;
+  scene.step = effective_step(in);
+  scene.skip = effective_skip(in);
+  std::vector<std::unique_ptr<DeviceTable>> tables;
+  for (int b = 0; b < scene.n_bands; ++b) {
+    const AxialRenderBand& band = in.bands[size_t(b)];
+    scene.extinction_ratio[b] = band.extinction_ratio;
+    scene.albedo[b] = band.table ? band.albedo : 0.0f;
+    scene.table[b] = TableView{};
+    if (band.table) {
+      tables.push_back(std::make_unique<DeviceTable>(*band.table));
+      scene.table[b] = tables.back()->view();
+      bytes += band.table->P.size() * sizeof(float);
+    }
+  }
+  std::vector<AxialStarView> stars(in.stars.size());
+  for (size_t k = 0; k < stars.size(); ++k) {
+    stars[k].position = in.stars[k].position;
+    for (int b = 0; b < scene.n_bands; ++b) stars[k].power[b] = in.stars[k].power[size_t(b)];
+    stars[k].depth_v = upload(*in.stars[k].depth_v);
+  }
+  DeviceBuffer<AxialStarView> device_stars(stars);
+  scene.stars = device_stars.get();
+  scene.n_stars = static_cast<int>(stars.size());
+
+  std::vector<std::string> names;
+  for (const AxialRenderBand& b : in.bands) names.push_back(b.name);
+  Image image(in.camera.width, in.camera.height, names);
+  DeviceBuffer<float> pixels(image.pixels.size());
+  DeviceBuffer<unsigned long long> clamps(1);
+  const dim3 block(16, 16), grid((in.camera.width + 15) / 16, (in.camera.height + 15) / 16);
+  CudaEventTimer timer;
+  axial_kernel<<<grid, block>>>(scene, in.camera, in.exposure, pixels.get(), clamps.get());
+  NEBULA_CUDA_CHECK(cudaGetLastError());
+  const double seconds = timer.seconds();
+  NEBULA_CUDA_CHECK(cudaMemcpy(image.pixels.data(), pixels.get(), image.pixels.size() * sizeof(float),
+                               cudaMemcpyDeviceToHost));
+  unsigned long long clamp_count = 0;
+  NEBULA_CUDA_CHECK(cudaMemcpy(&clamp_count, clamps.get(), sizeof clamp_count, cudaMemcpyDeviceToHost));
+  if (stats) {
+    stats->seconds = seconds;
+    stats->table_clamps = clamp_count;
+    stats->device_bytes = bytes;
+    stats->skip_used = scene.skip;
+  }
+  return image;
+}
+
+}  // namespace nebula

@@ -1,0 +1,107 @@
+// The axial marcher on the GPU: every skipping mode against the GPU's naive
+// march, and the GPU against the CPU.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/gpu.h"
+#include "raycast/axial_test_scenes.h"
+
+namespace nebula {
+namespace {
+
+using testing::AxialScene;
+
+struct Difference {
+  double peak = 0, worst = 0, mean = 0, flipped = 0;  // flipped: fraction of pixels off by > 1e-4 peak
+};
+
+Difference compare(const Image& a, const Image& ref) {
+  Difference d;
+  for (size_t i = 0; i < ref.pixels.size(); ++i) {
+    d.peak = std::max(d.peak, double(std::fabs(ref.pixels[i])));
+    const double e = std::fabs(double(a.pixels[i]) - ref.pixels[i]);
+    d.worst = std::max(d.worst, e);
+    d.mean += e;
+  }
+  d.mean /= std::max<size_t>(1, ref.pixels.size());
+  for (size_t i = 0; i < ref.pixels.size(); ++i)
+    d.flipped += std::fabs(double(a.pixels[i]) - ref.pixels[i]) > 1e-4 * d.peak;
+  d.flipped /= std::max<size_t>(1, ref.pixels.size());
+  return d;
+}
+
+// On one backend the skipping modes take the same arithmetic path through
+// the same non-empty samples as the naive march (one kernel, the mode a
+// run-time argument), so they are expected to be bit-identical on the GPU
+// too; the test allows 1e-6 of the peak and prints any difference.
+// Against the CPU: float contraction (FMA) moves sample positions by ulps, so
+// a sample within rounding of a texel boundary may read the neighbour texel,
+// changing its pixel by up to one sample's contribution. Such flips are rare:
+// at most 1% of the pixels may differ by more than 1e-4 of the peak, the mean
+// difference must stay below 1e-4 of the peak and none may exceed 1/4 of it.
+TEST(AxialRendererGpu, SkippingModesMatchNaiveAndTheCpu) {
+  std::string why;
+  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  for (const std::string& name : synthetic_axial_map_names()) {
+    AxialScene s(name, 96, 40);
+    for (int inc = 0; inc <= 90; inc += 15) {
+      for (float distance : {0.0f, 6.0f}) {
+        s.inputs.camera = s.view(inc, 64, distance);
+        s.inputs.skip = AxialSkip::Naive;
+        const Image naive = render_axial_cuda(s.inputs, nullptr);
+        const Image cpu = render_axial_cpu(s.inputs, nullptr);
+        const Difference c = compare(naive, cpu);
+        if (inc % 45 == 0)
+          std::printf("%s %d deg %s: GPU-CPU largest %.3g, mean %.3g of the peak %.3g; %.3g%% of pixels > 1e-4\n",
+                      name.c_str(), inc, distance > 0 ? "perspective" : "orthographic",
+                      c.peak > 0 ? c.worst / c.peak : 0.0, c.peak > 0 ? c.mean / c.peak : 0.0, c.peak,
+                      100 * c.flipped);
+        EXPECT_LE(c.flipped, 0.01) << name << " " << inc;
+        EXPECT_LE(c.mean, 1e-4 * c.peak) << name << " " << inc;
+        EXPECT_LE(c.worst, 0.25 * c.peak) << name << " " << inc;
+        for (float v : naive.pixels) ASSERT_TRUE(std::isfinite(v));
+        for (AxialSkip mode : {AxialSkip::Empty, AxialSkip::GlobalMax, AxialSkip::Omega, AxialSkip::OmegaMulti}) {
+          s.inputs.skip = mode;
+          const Difference d = compare(render_axial_cuda(s.inputs, nullptr), naive);
+          EXPECT_LE(d.worst, 1e-6 * d.peak) << name << " " << inc << " " << to_string(mode);
+          if (d.worst > 0)
+            std::printf("%s %d deg %s: not bit-identical (largest %.3g of the peak)\n", name.c_str(), inc,
+                        to_string(mode), d.worst / d.peak);
+        }
+      }
+    }
+  }
+}
+
+// The axial bake (the 3D bake on an nx x nr x 1 grid) on both backends, with
+// illumination_gpu_tests' bound: each of the nx + nr texel boundaries a path
+// crosses may move by 4 L 2^-24 (FMA contraction) and hand that much of the
+// densest texel's depth to its neighbour, plus 1e-5 relative.
+TEST(AxialRendererGpu, BakeAgreesWithTheCpu) {
+  std::string why;
+  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  const AxialMap m = synthetic_axial_map("lopsided", 128, 64, 0.01f, 0, 3.0f);
+  float densest = 0;
+  for (float v : m.tau_v) densest = std::max(densest, v);
+  const std::vector<float> xs{0.2f, 0.64f, -0.1f};  // inside, at a texel edge, beyond the map's start
+  const BakeResult cpu = bake_axial_star_depths(m.nx, m.nr, m.texel, m.tau_v, xs, Backend::Cpu);
+  const BakeResult gpu = bake_axial_star_depths(m.nx, m.nr, m.texel, m.tau_v, xs, Backend::Cuda);
+  ASSERT_EQ(gpu.tau_v.size(), xs.size());
+  for (size_t s = 0; s < xs.size(); ++s) {
+    double worst = 0;
+    for (int ir = 0; ir < m.nr; ++ir)
+      for (int ix = 0; ix < m.nx; ++ix) {
+        const size_t i = m.index(ix, ir);
+        const double L = std::hypot((ix + 0.5) * m.texel - xs[s], (ir + 0.5) * m.texel);
+        const double bound = 1e-5 * cpu.tau_v[s][i] + (m.nx + m.nr) * 4 * L * 0x1p-24 / m.texel * densest + 1e-7;
+        worst = std::max(worst, std::fabs(double(gpu.tau_v[s][i]) - cpu.tau_v[s][i]) / bound);
+      }
+    std::printf("star at x = %g: worst CPU-GPU difference %.3g of its bound\n", xs[s], worst);
+    EXPECT_LE(worst, 1.0);
+  }
+}
+
+}  // namespace
+}  // namespace nebula
