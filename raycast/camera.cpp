@@ -44,6 +44,8 @@ Camera make_camera(const CameraSettings& s) {
 
 Camera coarser_camera(const Camera& c) {
   Camera out = c;
+  if (out.frame_width <= 0) out.frame_width = c.width;
+  if (out.frame_height <= 0) out.frame_height = c.height;
   out.width = (c.width + 1) / 2;
   out.height = (c.height + 1) / 2;
   out.pixel_span = 2 * c.pixel_span;

@@ -23,16 +23,19 @@ struct Camera {
   // The frame the image covers, in pixels of the full-resolution image; a
   // coarser pyramid level (multires/) renders the same frame with pixels
   // pixel_span times larger (image width ceil(frame_width / pixel_span)).
+  // 0: the image's own width and height.
   int frame_width = 0, frame_height = 0;
   float pixel_span = 1;
 
   // The ray through the centre of pixel (px, py); false where the pixel shows
   // nothing (outside the dome circle of the fisheye).
   NEBULA_HD bool ray(int px, int py, Vec3& origin, Vec3& dir) const {
-    const float u = 2.0f * (px + 0.5f) * pixel_span / frame_width - 1.0f;   // -1 left .. 1 right
-    const float v = 1.0f - 2.0f * (py + 0.5f) * pixel_span / frame_height;  // 1 top .. -1 bottom
+    const float fw = float(frame_width > 0 ? frame_width : width);
+    const float fh = float(frame_height > 0 ? frame_height : height);
+    const float u = 2.0f * (px + 0.5f) * pixel_span / fw - 1.0f;   // -1 left .. 1 right
+    const float v = 1.0f - 2.0f * (py + 0.5f) * pixel_span / fh;  // 1 top .. -1 bottom
     if (projection == Projection::Perspective) {
-      const float aspect = float(frame_width) / float(frame_height);
+      const float aspect = fw / fh;
       origin = position;
       dir = normalize(forward + (u * aspect * tan_half_fov) * right + (v * tan_half_fov) * up);
       return true;
