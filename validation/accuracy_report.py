@@ -261,6 +261,24 @@ def write_markdown(rows, args, r, table_times, path, elapsed):
                        f"{x['rel_l2_excess']:.3g} | {x['worst_1pct']:.3g} | {ref['noise_rel_l2'] / np.sqrt(2):.3g} | "
                        f"{ss_text} |")
     out.append("")
+    if r.has_levels:
+        levels = sorted({x["value"] for x in rows if x["method"] == "fast pyramid"})
+        out.append("## The pyramid against the truth\n")
+        out.append("The same defaults with 0 (the row above) to "
+                   f"{max(levels) if levels else 0} levels of the multi-resolution pyramid (multires/README.md). "
+                   "Per cell: bias, then the L2 error beyond the truth's noise, then the worst 1% of pixels.\n")
+        out.append("| scene | " + " | ".join(f"{n} level{'s' if n != 1 else ''}" for n in [0] + levels) + " |")
+        out.append("|---|" + "---|" * (len(levels) + 1))
+        for scene in dict.fromkeys(x["scene"] for x in rows):
+            cells = []
+            for n in [0] + levels:
+                sel = [x for x in rows if x["scene"] == scene and (
+                    (n == 0 and x["method"] == "fast" and x["value"] == args.default_photons) or
+                    (n > 0 and x["method"] == "fast pyramid" and x["value"] == n))]
+                cells.append(f"{100 * sel[0]['bias']:+.1f}%, {sel[0]['rel_l2_excess']:.3f}, {sel[0]['worst_1pct']:.2f}"
+                             if sel else "—")
+            out.append(f"| {scene} | " + " | ".join(cells) + " |")
+        out.append("")
     out.append(FINDINGS)
     for scene in dict.fromkeys(x["scene"] for x in rows):
         out.append(f"## {scene}\n")
@@ -297,7 +315,7 @@ def main():
     p.add_argument("--steps", type=float, nargs="*", default=[1.0, 0.5, 0.25])
     p.add_argument("--resolutions", nargs="*", default=["100x18", "100x72", "1000x18", "1000x72"])
     p.add_argument("--table-photons-res", type=int, default=10000, help="photons per row of the resolution tables")
-    p.add_argument("--levels", type=int, nargs="*", default=[1, 2, 3])
+    p.add_argument("--levels", type=int, nargs="*", default=[1, 2, 3, 4])
     p.add_argument("--machine", default="", help="how the report names the machine")
     p.add_argument("--note", default="64x64, grids 32^3")
     p.add_argument("--docs", default=os.path.join(ROOT, "docs"))
