@@ -212,6 +212,10 @@ FINDINGS = open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "accura
     if os.path.exists(os.path.join(os.path.dirname(os.path.abspath(__file__)), "accuracy_findings.md")) else ""
 
 
+PYRAMID_FINDINGS = open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "accuracy_findings_pyramid.md")).read() \
+    if os.path.exists(os.path.join(os.path.dirname(os.path.abspath(__file__)), "accuracy_findings_pyramid.md")) else ""
+
+
 def write_markdown(rows, args, r, table_times, path, elapsed):
     machine = args.machine or f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores"
     out = []
@@ -261,6 +265,7 @@ def write_markdown(rows, args, r, table_times, path, elapsed):
                        f"{x['rel_l2_excess']:.3g} | {x['worst_1pct']:.3g} | {ref['noise_rel_l2'] / np.sqrt(2):.3g} | "
                        f"{ss_text} |")
     out.append("")
+    out.append(FINDINGS)
     if r.has_levels:
         levels = sorted({x["value"] for x in rows if x["method"] == "fast pyramid"})
         out.append("## The pyramid against the truth\n")
@@ -279,7 +284,7 @@ def write_markdown(rows, args, r, table_times, path, elapsed):
                              if sel else "—")
             out.append(f"| {scene} | " + " | ".join(cells) + " |")
         out.append("")
-    out.append(FINDINGS)
+        out.append(PYRAMID_FINDINGS)
     for scene in dict.fromkeys(x["scene"] for x in rows):
         out.append(f"## {scene}\n")
         out.append("| method | knob | value | time s | rel L1 | rel L2 | worst 1% | bias | noise | excess |")
