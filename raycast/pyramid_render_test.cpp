@@ -88,6 +88,35 @@ TEST(PyramidRender, LevelsRenderTheCoarserVolumesAtCoarserResolutions) {
   EXPECT_THROW(render_pyramid(s.in, 5, Backend::Cpu), Error);  // 32 -> 16 -> 8 -> 4 -> 2 is the most
 }
 
+// Emission climbs the pyramid like tau (j = 2 x mean of the children): the
+// radiance of a uniform, transparent emitting block does not depend on the
+// voxel size, so every level sees the same value in the block's interior.
+TEST(PyramidRender, EmissionIsCarriedToEveryLevel) {
+  DensityGrid grid = testing::cube(32, 1.0f);
+  std::vector<float> emission(grid.shape.count(), 0.0f);
+  for (int z = 0; z < 32; ++z)
+    for (int y = 0; y < 32; ++y)
+      for (int x = 0; x < 32; ++x)
+        if (z >= 8 && z < 24) emission[grid.shape.index(x, y, z)] = 0.5f;  // 16 voxels deep
+  RenderInputs in;
+  in.density = &grid;
+  in.bands = {RenderBand{"V", 1.0f, 0.0f, nullptr, &emission}};
+  CameraSettings cs;
+  cs.projection = Projection::Orthographic;
+  cs.position = {0, 0, -10};
+  cs.look_at = {0, 0, 0};
+  cs.ortho_width = 2;
+  cs.width = cs.height = 32;
+  in.camera = make_camera(cs);
+  const PyramidResult p = render_pyramid(in, 3, Backend::Cpu);
+  ASSERT_EQ(p.levels.size(), 4u);
+  for (const Image& level : p.levels) {
+    const float centre = level.at(0, level.width / 2, level.height / 2);
+    EXPECT_NEAR(centre, 16 * 0.5f, 1e-4f) << "level of width " << level.width;  // 16 voxels x j
+  }
+  for (size_t i = 0; i < p.image.pixels.size(); ++i) EXPECT_NEAR(p.image.pixels[i], p.levels[0].pixels[i], 1e-4f);
+}
+
 // The 2005 paper's Fig. 7: more levels make a layer in front of the star
 // brighter and bluer (multiple scattering over wider regions, strongest where
 // the dust is thickest: in B); a layer behind the star changes little. Each
