@@ -14,3 +14,12 @@
 #else
 #define NEBULA_ON_DEVICE 0
 #endif
+
+// Before a loop over bands (b < kMaxBands, leaving early past the scene's
+// count): fully unrolled on the device, so per-band arrays stay in registers
+// instead of the stack.
+#if defined(__CUDACC__)
+#define NEBULA_UNROLL _Pragma("unroll")
+#else
+#define NEBULA_UNROLL
+#endif

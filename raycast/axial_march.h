@@ -235,7 +235,9 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
       if (!empty) {
         const size_t cell = m.index(ix, ir);
         tau_v = m.tau_v[cell];
-        for (int b = 0; b < s.n_bands; ++b) {
+        NEBULA_UNROLL
+        for (int b = 0; b < kMaxBands; ++b) {
+          if (b >= s.n_bands) break;
           source[b] = m.emission[b] ? m.emission[b][cell] : 0.0f;
           dark = dark && source[b] == 0.0f;
         }
@@ -249,7 +251,9 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
             const float depth = star.depth_v[cell];
             float u = TableView::kNoAngle;
             int u_from = -1;
-            for (int b = 0; b < s.n_bands; ++b) {
+            NEBULA_UNROLL
+            for (int b = 0; b < kMaxBands; ++b) {
+              if (b >= s.n_bands) break;
               if (!(s.albedo[b] > 0.0f)) continue;
               if (u_from < 0 || s.table[b].bins.kind != s.table[u_from].bins.kind ||
                   s.table[b].bins.n != s.table[u_from].bins.n) {
@@ -266,12 +270,17 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
       empty = empty || dark;
       // T_in rule (DESIGN.md section 3), the texel in the voxel's part.
       const long long cell = empty ? -1 : static_cast<long long>(m.index(ix, ir));
-      if (cell != run_cell)
-        for (int b = 0; b < s.n_bands; ++b) t_entry[b] = out.transmittance[b];
+      if (cell != run_cell) {
+        NEBULA_UNROLL
+        for (int b = 0; b < kMaxBands; ++b)
+          if (b < s.n_bands) t_entry[b] = out.transmittance[b];
+      }
       run_cell = cell;
       const float fraction = chord * inv_texel;
       bool visible = false;
-      for (int b = 0; b < s.n_bands; ++b) {
+      NEBULA_UNROLL
+      for (int b = 0; b < kMaxBands; ++b) {
+        if (b >= s.n_bands) break;
         out.radiance[b] += t_entry[b] * source[b] * fraction;
         out.transmittance[b] *= expf(-tau_v * s.extinction_ratio[b] * fraction);
         visible = visible || out.transmittance[b] >= s.min_transmittance;

@@ -58,7 +58,9 @@ NEBULA_HD void scattered_source(const MarchScene& s, Vec3 pos, float tau_v, Vec3
     const float depth = depth_of(k);
     float u = TableView::kNoAngle;  // the angle's bin coordinate, shared by bands with equal binning
     int u_from = -1;
-    for (int b = 0; b < s.n_bands; ++b) {
+    NEBULA_UNROLL
+    for (int b = 0; b < kMaxBands; ++b) {
+      if (b >= s.n_bands) break;
       if (!(s.albedo[b] > 0.0f)) continue;
       if (u_from < 0 || s.table[b].bins.kind != s.table[u_from].bins.kind ||
           s.table[b].bins.n != s.table[u_from].bins.n) {
@@ -151,7 +153,9 @@ NEBULA_HD RayResult march_ray_in_mode(const MarchScene& s, Vec3 origin, Vec3 dir
         for (int b = 0; b < s.n_bands; ++b) source[b] += local[b] * step / fmaxf(chord, 1e-30f);
       }
     } else {
-      for (int b = 0; b < s.n_bands; ++b) source[b] = s.emission[b] ? s.emission[b][cell] : 0.0f;
+      NEBULA_UNROLL
+      for (int b = 0; b < kMaxBands; ++b)
+        if (b < s.n_bands) source[b] = s.emission[b] ? s.emission[b][cell] : 0.0f;
       if (tau_v > 0.0f && s.n_stars > 0) {
         scattered_source(s, g.centre(x, y, z), tau_v, to_eye,
                          [&](int k_star) { return s.stars[k_star].depth_v[cell]; }, source,
@@ -161,7 +165,9 @@ NEBULA_HD RayResult march_ray_in_mode(const MarchScene& s, Vec3 origin, Vec3 dir
     t += chord;
     const float fraction = chord * inv_voxel;
     bool visible = false;
-    for (int b = 0; b < s.n_bands; ++b) {
+    NEBULA_UNROLL
+    for (int b = 0; b < kMaxBands; ++b) {
+      if (b >= s.n_bands) break;
       out.radiance[b] += out.transmittance[b] * source[b] * fraction;
       out.transmittance[b] *= expf(-tau_v * s.extinction_ratio[b] * fraction);
       visible = visible || out.transmittance[b] >= s.min_transmittance;
