@@ -119,18 +119,7 @@ void run_axial_render(Scene& scene, const AxialCommandOptions& o) {
   for (float& v : image.pixels)
     if (!std::isfinite(v)) throw Error("axial render: a non-finite pixel (a bug: please report the scene)");
 
-  ImageMetadata meta;
-  meta.units = "L_sun pc^-2 sr^-1 x exposure";
-  meta.exposure = 1.0;
-  for (size_t b = 0; b < n_bands; ++b) {
-    meta.entries.push_back({"albedo_" + scene.bands[b], to_text(scene.dust.albedo[b])});
-    meta.entries.push_back({"g_" + scene.bands[b], to_text(scene.dust.g[b])});
-    meta.entries.push_back({"ext_" + scene.bands[b], to_text(sb.extinction_ratio[b])});
-  }
-  meta.entries.push_back({"R_V", to_text(scene.dust.R_V)});
-  meta.entries.push_back({"camera", std::string(to_string(scene.camera.kind)) + " " + std::to_string(camera.width) +
-                                        "x" + std::to_string(camera.height)});
-  meta.entries.push_back({"scene", scene.path});
+  ImageMetadata meta = scene_metadata(scene, sb, camera);
   meta.entries.push_back({"mode", std::string("axial ") + to_string(skip) + " step " + to_text(spec.step_texels) + " texel"});
   write_image(image, out, meta, o.force);
 

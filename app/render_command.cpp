@@ -159,18 +159,7 @@ void run_render(const Options& o) {
                      scene.star_psf_pixels, image);
   }
 
-  ImageMetadata meta;
-  meta.units = "L_sun pc^-2 sr^-1 x exposure";
-  meta.exposure = 1.0;  // the camera exposure is already in the pixels
-  for (size_t b = 0; b < n_bands; ++b) {
-    meta.entries.push_back({"albedo_" + scene.bands[b], to_text(scene.dust.albedo[b])});
-    meta.entries.push_back({"g_" + scene.bands[b], to_text(scene.dust.g[b])});
-    meta.entries.push_back({"ext_" + scene.bands[b], to_text(ratios[b])});
-  }
-  meta.entries.push_back({"R_V", to_text(scene.dust.R_V)});
-  meta.entries.push_back({"camera", std::string(to_string(scene.camera.kind)) + " " + std::to_string(camera.width) +
-                                        "x" + std::to_string(camera.height)});
-  meta.entries.push_back({"scene", scene.path});
+  ImageMetadata meta = scene_metadata(scene, sb, camera);
   meta.entries.push_back({"mode", o.smooth > 0 ? "smooth step " + to_text(o.smooth) + " voxel" : "exact"});
   meta.entries.push_back({"pyramid_levels", std::to_string(scene.pyramid_levels)});
   write_image(image, out, meta, o.force);

@@ -41,6 +41,22 @@ SceneBands scene_bands(const Scene& scene) {
   return out;
 }
 
+ImageMetadata scene_metadata(const Scene& scene, const SceneBands& bands, const Camera& camera) {
+  ImageMetadata meta;
+  meta.units = "L_sun pc^-2 sr^-1 x exposure";
+  meta.exposure = 1.0;  // the camera exposure is already in the pixels
+  for (size_t b = 0; b < scene.bands.size(); ++b) {
+    meta.entries.push_back({"albedo_" + scene.bands[b], to_text(scene.dust.albedo[b])});
+    meta.entries.push_back({"g_" + scene.bands[b], to_text(scene.dust.g[b])});
+    meta.entries.push_back({"ext_" + scene.bands[b], to_text(bands.extinction_ratio[b])});
+  }
+  meta.entries.push_back({"R_V", to_text(scene.dust.R_V)});
+  meta.entries.push_back({"camera", std::string(to_string(scene.camera.kind)) + " " + std::to_string(camera.width) +
+                                        "x" + std::to_string(camera.height)});
+  meta.entries.push_back({"scene", scene.path});
+  return meta;
+}
+
 void check_image_extension(const std::string& option, const std::string& out) {
   const auto dot = out.rfind('.');
   const std::string ext = dot == std::string::npos ? "" : out.substr(dot);

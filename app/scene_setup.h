@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "illumination/passband.h"
+#include "imageio/image_output.h"
 #include "raycast/camera.h"
 #include "scene/scene.h"
 
@@ -20,6 +21,11 @@ struct SceneBands {
 };
 
 SceneBands scene_bands(const Scene& scene);
+
+// What every rendered image records of its scene: units, per-band albedo, g
+// and extinction ratio, R_V, the camera and the scene file. Callers add their
+// own "mode" entry.
+ImageMetadata scene_metadata(const Scene& scene, const SceneBands& bands, const Camera& camera);
 
 // Refuses an image format before any work: by extension, and .exr/.png when
 // this build has no OpenImageIO.

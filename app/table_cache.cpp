@@ -6,7 +6,7 @@
 #include <memory>
 #include <sstream>
 
-#include "app/table_conversion.h"
+#include "validation/table_conversion.h"
 #include "core/error.h"
 #include "core/progress.h"
 #include "tables/table_file.h"

@@ -7,7 +7,7 @@
 
 #include "app/commands.h"
 #include "app/output_path.h"
-#include "app/table_conversion.h"
+#include "validation/table_conversion.h"
 #include "core/error.h"
 #include "core/math.h"
 #include "core/progress.h"

@@ -85,16 +85,7 @@ void run_truth(const Options& o) {
                      scene.star_psf_pixels, result.image);
   }
 
-  ImageMetadata meta;
-  meta.units = "L_sun pc^-2 sr^-1 x exposure";
-  meta.exposure = 1.0;
-  for (size_t b = 0; b < n_bands; ++b) {
-    meta.entries.push_back({"albedo_" + scene.bands[b], to_text(scene.dust.albedo[b])});
-    meta.entries.push_back({"g_" + scene.bands[b], to_text(scene.dust.g[b])});
-    meta.entries.push_back({"ext_" + scene.bands[b], to_text(sb.extinction_ratio[b])});
-  }
-  meta.entries.push_back({"R_V", to_text(scene.dust.R_V)});
-  meta.entries.push_back({"scene", scene.path});
+  ImageMetadata meta = scene_metadata(scene, sb, camera);
   meta.entries.push_back({"mode", "truth spp " + std::to_string(spp) + " seed " + std::to_string(o.seed) + " " +
                                       o.transmittance + " transmittance" + (o.equiangular ? " equiangular" : "") +
                                       (o.max_orders ? " orders<=" + std::to_string(o.max_orders) : "")});

@@ -243,28 +243,9 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
         }
         dark = dark && tau_v == 0.0f;
         if (tau_v > 0.0f) {
-          for (int k_star = 0; k_star < s.n_stars; ++k_star) {
-            const AxialStarView& star = s.stars[k_star];
-            const Vec3 d = pos - star.position;
-            const float dist = length(d);
-            const float mu = dist > 0.0f ? dot(d, to_eye) / dist : 0.0f;
-            const float depth = star.depth_v[cell];
-            float u = TableView::kNoAngle;
-            int u_from = -1;
-            NEBULA_UNROLL
-            for (int b = 0; b < kMaxBands; ++b) {
-              if (b >= s.n_bands) break;
-              if (!(s.albedo[b] > 0.0f)) continue;
-              if (u_from < 0 || s.table[b].bins.kind != s.table[u_from].bins.kind ||
-                  s.table[b].bins.n != s.table[u_from].bins.n) {
-                u = s.table[b].angle_coordinate(mu);
-                u_from = b;
-              }
-              const float tau_b = tau_v * s.extinction_ratio[b];
-              const float e = star_irradiance(star.power[b], dist, m.texel, depth * s.extinction_ratio[b]);
-              source[b] += e * s.table[b].lookup_at(s.albedo[b] * tau_b, u, &out.table_clamps);
-            }
-          }
+          for (int k_star = 0; k_star < s.n_stars; ++k_star)
+            add_star_light(s, s.stars[k_star].position, s.stars[k_star].power, s.stars[k_star].depth_v[cell], pos,
+                           tau_v, m.texel, to_eye, source, &out.table_clamps);
         }
       }
       empty = empty || dark;

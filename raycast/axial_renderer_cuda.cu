@@ -7,34 +7,13 @@
 #include <vector>
 
 #include "core/cuda_check.h"
+#include "core/device_array.h"
 #include "core/cuda_timer.h"
 #include "raycast/axial_renderer.h"
 #include "tables/device_table.h"
 
 namespace nebula {
 namespace {
-
-template <class T>
-class DeviceBuffer {
- public:
-  explicit DeviceBuffer(const std::vector<T>& host) : size_(host.size()) {
-    NEBULA_CUDA_CHECK(cudaMalloc(&ptr_, std::max<size_t>(1, size_) * sizeof(T)));
-    if (size_) NEBULA_CUDA_CHECK(cudaMemcpy(ptr_, host.data(), size_ * sizeof(T), cudaMemcpyHostToDevice));
-  }
-  explicit DeviceBuffer(size_t n) : size_(n) {
-    NEBULA_CUDA_CHECK(cudaMalloc(&ptr_, std::max<size_t>(1, n) * sizeof(T)));
-    NEBULA_CUDA_CHECK(cudaMemset(ptr_, 0, std::max<size_t>(1, n) * sizeof(T)));
-  }
-  ~DeviceBuffer() { cudaFree(ptr_); }
-  DeviceBuffer(const DeviceBuffer&) = delete;
-  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
-  T* get() const { return ptr_; }
-  size_t bytes() const { return size_ * sizeof(T); }
-
- private:
-  T* ptr_ = nullptr;
-  size_t size_ = 0;
-};
 
 // Blocks of 256 threads per SM the compiler must fit in registers.
 #ifndef NEBULA_AXIAL_MIN_BLOCKS
@@ -63,17 +42,17 @@ Image render_axial_cuda(const AxialRenderInputs& in, AxialRenderStats* stats) {
   const AxialMap& m = *in.map;
   AxialMarchScene scene{};
   scene.map = m.view();  // host pointers, replaced below
-  std::vector<std::unique_ptr<DeviceBuffer<float>>> floats;
+  std::vector<std::unique_ptr<DeviceArray<float>>> floats;
   size_t bytes = 0;
   auto upload = [&](const std::vector<float>& v) {
-    floats.push_back(std::make_unique<DeviceBuffer<float>>(v));
+    floats.push_back(std::make_unique<DeviceArray<float>>(v));
     bytes += floats.back()->bytes();
     return floats.back()->get();
   };
   scene.map.tau_v = upload(m.tau_v);
   for (int b = 0; b < kAxialMaxBands; ++b) scene.map.emission[b] = nullptr;
   for (size_t b = 0; b < m.emission.size(); ++b) scene.map.emission[b] = upload(m.emission[b]);
-  DeviceBuffer<int> height(m.height), floor(m.floor), tree(m.tree), floor_tree(m.floor_tree);
+  DeviceArray<int> height(m.height), floor(m.floor), tree(m.tree), floor_tree(m.floor_tree);
   bytes += height.bytes() + floor.bytes() + tree.bytes() + floor_tree.bytes();
   scene.map.height = height.get();
   scene.map.floor = floor.get();
@@ -101,15 +80,15 @@ Image render_axial_cuda(const AxialRenderInputs& in, AxialRenderStats* stats) {
     for (int b = 0; b < scene.n_bands; ++b) stars[k].power[b] = in.stars[k].power[size_t(b)];
     stars[k].depth_v = upload(*in.stars[k].depth_v);
   }
-  DeviceBuffer<AxialStarView> device_stars(stars);
+  DeviceArray<AxialStarView> device_stars(stars);
   scene.stars = device_stars.get();
   scene.n_stars = static_cast<int>(stars.size());
 
   std::vector<std::string> names;
   for (const AxialRenderBand& b : in.bands) names.push_back(b.name);
   Image image(in.camera.width, in.camera.height, names);
-  DeviceBuffer<float> pixels(image.pixels.size());
-  DeviceBuffer<unsigned long long> clamps(1);
+  DeviceArray<float> pixels(image.pixels.size());
+  DeviceArray<unsigned long long> clamps(1);
   const dim3 block(16, 16), grid((in.camera.width + 15) / 16, (in.camera.height + 15) / 16);
   CudaEventTimer timer;
   axial_kernel<<<grid, block>>>(scene, in.camera, in.exposure, pixels.get(), clamps.get());

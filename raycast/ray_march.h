@@ -42,6 +42,35 @@ struct RayResult {
   int table_clamps;
 };
 
+// One star's light that dust at `pos` (V-band depth tau_v per cell edge
+// `edge`) sends towards the eye per band, per unit of chord / edge, added to
+// `source`: E P(tau_sct, theta). depth_v is the star's baked V-band depth to
+// the cell. Shared by the 3D marcher and the axial one (Scene: n_bands,
+// extinction_ratio, albedo, table).
+template <class Scene>
+NEBULA_HD void add_star_light(const Scene& s, Vec3 star, const float* power, float depth_v, Vec3 pos, float tau_v,
+                              float edge, Vec3 to_eye, float* source, int* clamps) {
+  const Vec3 d = pos - star;
+  const float r = length(d);
+  // theta: between the light's direction (star to dust) and the way to the eye.
+  const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
+  float u = TableView::kNoAngle;  // the angle's bin coordinate, shared by bands with equal binning
+  int u_from = -1;
+  NEBULA_UNROLL
+  for (int b = 0; b < kMaxBands; ++b) {
+    if (b >= s.n_bands) break;
+    if (!(s.albedo[b] > 0.0f)) continue;
+    if (u_from < 0 || s.table[b].bins.kind != s.table[u_from].bins.kind ||
+        s.table[b].bins.n != s.table[u_from].bins.n) {
+      u = s.table[b].angle_coordinate(mu);
+      u_from = b;
+    }
+    const float tau_b = tau_v * s.extinction_ratio[b];
+    const float e = star_irradiance(power[b], r, edge, depth_v * s.extinction_ratio[b]);
+    source[b] += e * s.table[b].lookup_at(s.albedo[b] * tau_b, u, clamps);
+  }
+}
+
 // Light that dust at `pos` (V-band depth per voxel edge tau_v) sends towards
 // the eye per band, per unit of chord / l: sum over stars of E_s P(tau_sct,
 // theta_s). depth_of(k) is star k's baked V-band depth to this point.
@@ -49,29 +78,9 @@ template <class DepthOf>
 NEBULA_HD void scattered_source(const MarchScene& s, Vec3 pos, float tau_v, Vec3 to_eye,
                                 DepthOf&& depth_of, float* source, int* clamps) {
   if (!(tau_v > 0.0f)) return;
-  for (int k = 0; k < s.n_stars; ++k) {
-    const StarView& star = s.stars[k];
-    const Vec3 d = pos - star.position;
-    const float r = length(d);
-    // theta: between the light's direction (star to dust) and the way to the eye.
-    const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
-    const float depth = depth_of(k);
-    float u = TableView::kNoAngle;  // the angle's bin coordinate, shared by bands with equal binning
-    int u_from = -1;
-    NEBULA_UNROLL
-    for (int b = 0; b < kMaxBands; ++b) {
-      if (b >= s.n_bands) break;
-      if (!(s.albedo[b] > 0.0f)) continue;
-      if (u_from < 0 || s.table[b].bins.kind != s.table[u_from].bins.kind ||
-          s.table[b].bins.n != s.table[u_from].bins.n) {
-        u = s.table[b].angle_coordinate(mu);
-        u_from = b;
-      }
-      const float tau_b = tau_v * s.extinction_ratio[b];
-      const float e = star_irradiance(star.power[b], r, s.density.shape.voxel, depth * s.extinction_ratio[b]);
-      source[b] += e * s.table[b].lookup_at(s.albedo[b] * tau_b, u, clamps);
-    }
-  }
+  for (int k = 0; k < s.n_stars; ++k)
+    add_star_light(s, s.stars[k].position, s.stars[k].power, depth_of(k), pos, tau_v, s.density.shape.voxel, to_eye,
+                   source, clamps);
 }
 
 // A cell-centred field at `pos`: trilinear (clamped at the grid's edge) or

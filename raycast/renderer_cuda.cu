@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/cuda_check.h"
+#include "core/device_array.h"
 #include "core/cuda_timer.h"
 #include "multires/pyramid_pixels.h"
 #include "raycast/pyramid_render.h"
@@ -14,29 +15,6 @@
 
 namespace nebula {
 namespace {
-
-// Device copy of a host vector, freed on scope exit.
-template <class T>
-class DeviceArray {
- public:
-  explicit DeviceArray(const std::vector<T>& host) : size_(host.size()) {
-    NEBULA_CUDA_CHECK(cudaMalloc(&ptr_, std::max<size_t>(1, size_) * sizeof(T)));
-    if (size_)
-      NEBULA_CUDA_CHECK(cudaMemcpy(ptr_, host.data(), size_ * sizeof(T), cudaMemcpyHostToDevice));
-  }
-  explicit DeviceArray(size_t n) : size_(n) {
-    NEBULA_CUDA_CHECK(cudaMalloc(&ptr_, std::max<size_t>(1, n) * sizeof(T)));
-    NEBULA_CUDA_CHECK(cudaMemset(ptr_, 0, std::max<size_t>(1, n) * sizeof(T)));
-  }
-  ~DeviceArray() { cudaFree(ptr_); }
-  DeviceArray(const DeviceArray&) = delete;
-  DeviceArray& operator=(const DeviceArray&) = delete;
-  T* get() const { return ptr_; }
-
- private:
-  T* ptr_ = nullptr;
-  size_t size_ = 0;
-};
 
 // Blocks of 256 threads per SM the compiler must fit in registers (exact
 // mode). With the band loops unrolled (per-band arrays in registers, not on

@@ -1,39 +1,12 @@
 #include <utility>
 
 #include "core/cuda_check.h"
+#include "core/device_array.h"
 #include "tables/device_table.h"
 
 namespace nebula {
 
 namespace {
-
-// A device array that frees itself; errors become nebula::Error.
-template <class T>
-class DeviceArray {
- public:
-  explicit DeviceArray(size_t count) : count_(count) {
-    if (count_ > 0) NEBULA_CUDA_CHECK(cudaMalloc(&data_, count_ * sizeof(T)));
-  }
-  ~DeviceArray() {
-    if (data_ != nullptr) cudaFree(data_);
-  }
-  DeviceArray(const DeviceArray&) = delete;
-  DeviceArray& operator=(const DeviceArray&) = delete;
-
-  T* get() const { return data_; }
-  void upload(const T* host) {
-    if (count_ > 0)
-      NEBULA_CUDA_CHECK(cudaMemcpy(data_, host, count_ * sizeof(T), cudaMemcpyHostToDevice));
-  }
-  void download(T* host) const {
-    if (count_ > 0)
-      NEBULA_CUDA_CHECK(cudaMemcpy(host, data_, count_ * sizeof(T), cudaMemcpyDeviceToHost));
-  }
-
- private:
-  T* data_ = nullptr;
-  size_t count_;
-};
 
 __global__ void lookup_kernel(TableView table, const float* tau, const float* mu, float* out,
                               size_t count, unsigned long long* clamped) {

@@ -11,6 +11,7 @@
 #include "raycast/renderer.h"
 #include "scene/density_sources.h"
 #include "tables/scattering_table.h"
+#include "validation/table_conversion.h"
 #include "validation/truth_renderer.h"
 
 namespace nebula {
@@ -122,17 +123,18 @@ struct BenchNebula {
   Vec3 centre;
   ScatteringTable table;
   CameraSettings camera;
-  BenchNebula(Backend backend, int size, int width, int height) {
+  // with_table: also tabulate the table (the path tracer needs none).
+  BenchNebula(Backend backend, int size, int width, int height, bool with_table = true) {
     ProceduralParams pp;
     pp.n = size;
     grid = procedural_nebula(pp);
     centre = procedural_star_position(pp);
-    TabulateParams tp;
-    tp.photons_per_row = 10000;
-    tp.binning = AngularBinning::UniformTheta;
-    const Tabulation tab = tabulate(tp, backend);
-    table = ScatteringTable::make_axes(tp.tau_max, tp.tau_bins, tp.binning, tp.mu_bins);
-    for (size_t e = 0; e < tab.P.size(); ++e) table.P[e] = static_cast<float>(tab.P[e]);
+    if (with_table) {
+      TabulateParams tp;
+      tp.photons_per_row = 10000;
+      tp.binning = AngularBinning::UniformTheta;
+      table = to_table(tabulate(tp, backend));
+    }
     camera.position = centre + Vec3{0.4f, -3.2f, 1.1f};
     camera.look_at = centre;
     camera.up = {0, 0, 1};
@@ -217,23 +219,13 @@ namespace nebula {
 
 TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int spp, int repeats,
                           bool exact_transmittance, bool equiangular) {
-  ProceduralParams pp;
-  pp.n = size;
-  const DensityGrid grid = procedural_nebula(pp);
-  const Vec3 centre = procedural_star_position(pp);
-  CameraSettings cs;
-  cs.position = centre + Vec3{0.4f, -3.2f, 1.1f};
-  cs.look_at = centre;
-  cs.up = {0, 0, 1};
-  cs.fov_deg = 45;
-  cs.width = width;
-  cs.height = height;
+  const BenchNebula nebula(backend, size, width, height, false);
   TruthInputs in;
-  in.density = &grid;
+  in.density = &nebula.grid;
   const float ratios[3] = {1.2f, 1.0f, 0.85f};
   for (int b = 0; b < 3; ++b) in.bands.push_back(TruthBand{std::string(1, "BVR"[b]), ratios[b], 0.6f, 0.6f, nullptr});
-  in.stars = {TruthStar{centre, {1e3f, 1e3f, 1e3f}}};
-  in.camera = make_camera(cs);
+  in.stars = {TruthStar{nebula.centre, {1e3f, 1e3f, 1e3f}}};
+  in.camera = make_camera(nebula.camera);
   in.spp = spp;
   in.exact_transmittance = exact_transmittance;
   in.equiangular = equiangular;
@@ -266,9 +258,7 @@ void bench_axial(Backend backend, int map_size, int width, int height, int repea
     TabulateParams tp;
     tp.photons_per_row = 2000;  // the table's values do not change the timing
     tp.binning = AngularBinning::UniformTheta;
-    const Tabulation tab = tabulate(tp, backend);
-    table = ScatteringTable::make_axes(tp.tau_max, tp.tau_bins, tp.binning, tp.mu_bins);
-    for (size_t e = 0; e < tab.P.size(); ++e) table.P[e] = static_cast<float>(tab.P[e]);
+    table = to_table(tabulate(tp, backend));
   }
   const float texel = 1.0f / map_size;
   for (const std::string& name : maps) {

@@ -8,32 +8,12 @@
 #include <vector>
 
 #include "core/cuda_check.h"
+#include "core/device_array.h"
 #include "core/cuda_timer.h"
 #include "validation/truth_renderer.h"
 
 namespace nebula {
 namespace {
-
-template <class T>
-class DeviceArray {
- public:
-  explicit DeviceArray(const std::vector<T>& host) {
-    NEBULA_CUDA_CHECK(cudaMalloc(&ptr_, std::max<size_t>(1, host.size()) * sizeof(T)));
-    if (!host.empty())
-      NEBULA_CUDA_CHECK(cudaMemcpy(ptr_, host.data(), host.size() * sizeof(T), cudaMemcpyHostToDevice));
-  }
-  explicit DeviceArray(size_t n) {
-    NEBULA_CUDA_CHECK(cudaMalloc(&ptr_, std::max<size_t>(1, n) * sizeof(T)));
-    NEBULA_CUDA_CHECK(cudaMemset(ptr_, 0, std::max<size_t>(1, n) * sizeof(T)));
-  }
-  ~DeviceArray() { cudaFree(ptr_); }
-  DeviceArray(const DeviceArray&) = delete;
-  DeviceArray& operator=(const DeviceArray&) = delete;
-  T* get() const { return ptr_; }
-
- private:
-  T* ptr_ = nullptr;
-};
 
 __global__ void truth_kernel(PathScene scene, Camera camera, float exposure, int spp, float* image, float* variance,
                              unsigned long long* counters) {

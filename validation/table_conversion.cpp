@@ -1,6 +1,6 @@
-#include "app/table_conversion.h"
+#include "validation/table_conversion.h"
 
-namespace nebula::app {
+namespace nebula {
 
 namespace {
 constexpr const char* kGenerator = "nebula 0.1.0";
@@ -31,4 +31,4 @@ ScatteringTable to_table(const Tabulation& t) {
   return table;
 }
 
-}  // namespace nebula::app
+}  // namespace nebula

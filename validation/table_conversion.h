@@ -2,9 +2,9 @@
 #include "montecarlo/tabulate.h"
 #include "tables/scattering_table.h"
 
-namespace nebula::app {
+namespace nebula {
 
 // The tabulator's result as the table file's type, with its provenance.
 ScatteringTable to_table(const Tabulation& t);
 
-}  // namespace nebula::app
+}  // namespace nebula
