@@ -9,6 +9,7 @@
 
 #include "app/commands.h"
 #include "app/output_path.h"
+#include "raycast/axial_renderer.h"
 #include "core/error.h"
 #include "core/progress.h"
 #include "montecarlo/slab.h"
@@ -318,6 +319,7 @@ void add_bench_command(CLI::App& app) {
                                           "(Khalass 2021, Tables 5.1-5.5)");
   struct AxialOptions {
     std::string backends = "auto", maps = "bipolar,lopsided,shells,empty,full", inclinations = "0,15,30,45,60,75,90";
+    std::string modes = "all";
     int map_size = 1024, image = 2048, repeats = 5;
     float step = 0.5f;
     bool emission_only = false, step_aside = true;
@@ -331,6 +333,8 @@ void add_bench_command(CLI::App& app) {
   ax->add_option("--step", x->step, "march step, texels")->capture_default_str();
   ax->add_option("--maps", x->maps, "comma-separated synthetic maps")->capture_default_str();
   ax->add_option("--inclinations", x->inclinations, "comma-separated degrees from the axis")->capture_default_str();
+  ax->add_option("--modes", x->modes, "comma-separated skip modes, or all (naive always runs, first)")
+      ->capture_default_str();
   ax->add_flag("--emission-only", x->emission_only, "no star: the thesis' emission-absorption model only");
   ax->add_flag("!--no-step-aside", x->step_aside,
                "run the skip code even on maps without empty texels (its overhead on the full map)");
@@ -363,6 +367,9 @@ void add_bench_command(CLI::App& app) {
       if (t.empty() || *end != '\0' || v < 0 || v > 90) throw Error("--inclinations: '" + t + "' is not a whole degree in 0..90");
       inclinations.push_back(int(v));
     }
+    std::vector<AxialSkip> modes;
+    if (x->modes != "all")
+      for (const std::string& m : split(x->modes)) modes.push_back(parse_axial_skip(m, "--modes"));
     std::vector<Backend> backends;
     if (x->backends == "both" || (x->backends == "auto" && gpu_available()))
       backends = {Backend::Cpu, Backend::Cuda};
@@ -383,7 +390,7 @@ void add_bench_command(CLI::App& app) {
                                 (unsigned long long)r.samples);
                     std::fflush(stdout);
                   },
-                  x->step_aside);
+                  x->step_aside, modes);
     }
   });
 }

@@ -55,6 +55,37 @@ void AxialMap::update_skip_structures() {
     at = next;
   }
   if (level_offset.size() > size_t(kAxialMaxTreeLevels)) throw Error("axial map: too many columns for the max-tree");
+  update_distance_map();
+}
+
+// The chessboard distance transform in two raster passes over the 8
+// neighbours with unit steps, exact for the Chebyshev metric (Rosenfeld &
+// Pfaltz 1966), linear in the texels.
+void AxialMap::update_distance_map() {
+  constexpr int kFar = kAxialMaxDistance;
+  std::vector<int> d(count());
+  for (size_t i = 0; i < count(); ++i) d[i] = empty_at(i) ? kFar : 0;
+  auto relax = [&](int ix, int ir, int jx, int jr) {
+    if (jx < 0 || jx >= nx || jr < 0 || jr >= nr) return;
+    int& here = d[index(ix, ir)];
+    here = std::min(here, d[index(jx, jr)] + 1);
+  };
+  for (int ir = 0; ir < nr; ++ir)
+    for (int ix = 0; ix < nx; ++ix) {
+      relax(ix, ir, ix - 1, ir);
+      relax(ix, ir, ix - 1, ir - 1);
+      relax(ix, ir, ix, ir - 1);
+      relax(ix, ir, ix + 1, ir - 1);
+    }
+  for (int ir = nr - 1; ir >= 0; --ir)
+    for (int ix = nx - 1; ix >= 0; --ix) {
+      relax(ix, ir, ix + 1, ir);
+      relax(ix, ir, ix + 1, ir + 1);
+      relax(ix, ir, ix, ir + 1);
+      relax(ix, ir, ix - 1, ir + 1);
+    }
+  distance.resize(count());
+  for (size_t i = 0; i < count(); ++i) distance[i] = static_cast<uint8_t>(std::min(d[i], kFar));
 }
 
 AxialView AxialMap::view() const {
@@ -73,13 +104,15 @@ AxialView AxialMap::view() const {
   v.n_levels = static_cast<int>(level_offset.size());
   for (int k = 0; k < v.n_levels; ++k) v.level_offset[k] = level_offset[size_t(k)];
   v.global_max = global_max;
+  v.distance = distance.data();
   return v;
 }
 
 size_t AxialMap::bytes() const {
   size_t floats = tau_v.size();
   for (const auto& e : emission) floats += e.size();
-  return floats * sizeof(float) + (height.size() + floor.size() + tree.size() + floor_tree.size()) * sizeof(int);
+  return floats * sizeof(float) + (height.size() + floor.size() + tree.size() + floor_tree.size()) * sizeof(int) +
+         distance.size();
 }
 
 void check_axial_map(const AxialMap& map, const std::string& what) {

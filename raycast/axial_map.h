@@ -10,8 +10,12 @@
 // h[ix] = 1 + the highest non-empty r index (0 for an empty column), its
 // global maximum H and a max-tree over h; and the floor map f[ix] = the
 // lowest non-empty r index (kAxialEmptyFloor for an empty column) with a min-tree, for the
-// hollow inside of shells and lobes. Empty means tau_v == 0 and every
-// band's emission == 0.
+// hollow inside of shells and lobes. Beyond the thesis, every texel carries
+// its Chebyshev distance (in texels) to the nearest non-empty texel, the
+// proximity clouds of Cohen & Sheffer (1994), for the `distance` skip mode:
+// one byte per texel, so the map stays small in the caches.
+// Empty means tau_v == 0 and every band's emission == 0.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -23,6 +27,7 @@ namespace nebula {
 constexpr int kAxialMaxBands = 4;  // equals kMaxBands of ray_march.h
 constexpr int kAxialMaxTreeLevels = 32;
 constexpr int kAxialEmptyFloor = 1 << 30;  // the floor of an empty column: every r is below it
+constexpr int kAxialMaxDistance = 255;     // the distance map's cap (a lower bound beyond it)
 
 // A non-owning view for kernels (host or device pointers), by value.
 struct AxialView {
@@ -39,6 +44,9 @@ struct AxialView {
   int level_offset[kAxialMaxTreeLevels] = {};     // start of each level in `tree`
   int n_levels = 0;
   int global_max = 0;                             // H = max over h
+  // [ir * nx + ix]: max(|jx - ix|, |jr - ir|) to the nearest non-empty texel
+  // (jx, jr), 0 for a non-empty texel, capped at kAxialMaxDistance.
+  const uint8_t* distance = nullptr;
 
   NEBULA_HD size_t index(int ix, int ir) const { return size_t(ir) * nx + ix; }
   NEBULA_HD float length() const { return nx * texel; }
@@ -111,6 +119,7 @@ struct AxialMap {
   std::vector<int> tree;
   std::vector<int> floor_tree;  // min-tree of floor, levels as tree's
   std::vector<int> level_offset;
+  std::vector<uint8_t> distance;  // Chebyshev distance to the nearest non-empty texel (AxialView::distance)
   int global_max = 0;
   size_t empty_texels = 0;  // texels with no dust and no emission
 
@@ -120,8 +129,10 @@ struct AxialMap {
   size_t index(int ix, int ir) const { return size_t(ir) * nx + ix; }
   bool empty_at(size_t i) const;
 
-  // Recomputes height, tree and global_max from tau_v and emission.
+  // Recomputes height, floor, their trees, global_max and the distance map
+  // from tau_v and emission.
   void update_skip_structures();
+  void update_distance_map();  // part of update_skip_structures
   // A host view (pointers into this map).
   AxialView view() const;
   // Bytes of the map with its skip structures (the memory the renderer uploads).

@@ -19,6 +19,7 @@
 // the naive march: the images are bit-identical on one backend.
 #include <cfloat>
 #include <cmath>
+#include <type_traits>
 
 #include "core/hd.h"
 #include "core/vec3.h"
@@ -29,13 +30,16 @@
 
 namespace nebula {
 
-// Ordered: each mode does everything the previous one does.
+// Naive to OmegaMulti are the thesis' modes, ordered: each does everything
+// the previous one does. Distance is ours: GlobalMax's clipping, then jumps
+// sized by the distance map (proximity clouds) instead of omega attempts.
 enum class AxialSkip : int {
-  Naive = 0,      // every sample: texel fetch and shading
-  Empty = 1,      // the height and floor maps decide a sample is empty before any texel fetch
-  GlobalMax = 2,  // ... and only the samples inside the cylinder of radius H l are visited
-  Omega = 3,      // ... and from an empty sample, jump omega_max (the rest) or omega_large = omega_max / 32
-  OmegaMulti = 4  // ... adaptive jumps (doubling on success, halving on failure), range maxima from the max-tree
+  Naive = 0,       // every sample: texel fetch and shading
+  Empty = 1,       // the height and floor maps decide a sample is empty before any texel fetch
+  GlobalMax = 2,   // ... and only the samples inside the cylinder of radius H l are visited
+  Omega = 3,       // ... and from an empty sample, jump omega_max (the rest) or omega_large = omega_max / 32
+  OmegaMulti = 4,  // ... adaptive jumps (doubling on success, halving on failure), range maxima from the max-tree
+  Distance = 5     // GlobalMax, then from every empty sample the longest jump its texel's distance allows
 };
 
 const char* to_string(AxialSkip mode);
@@ -170,10 +174,38 @@ NEBULA_HD bool stretch_is_empty(const AxialView& m, const AxialRay& ray, float t
   return true;
 }
 
+// How far (along the ray, world units) the ray may go from a sample at
+// (x, r) in texel (ix, ir), whose Chebyshev distance to the nearest non-empty
+// texel is d >= 1, and stay in the empty box of texels within d - 1 of it.
+// Along the ray x moves at |dx| and r at most at |wd| (triangle inequality),
+// so the box's slack on each side, less the margin eps for the rounding of
+// sample positions, over that speed bounds the reach. Sides beyond the map
+// do not count: samples there are outside, hence empty.
+NEBULA_HD float distance_reach(const AxialView& m, const AxialRay& ray, float inv_dx, float inv_wd, float x,
+                               float r, int ix, int ir, int d, float eps) {
+  constexpr float kFar = 3.0e38f;
+  const float l = m.texel;
+  const float x_hi = ix + d < m.nx ? float(ix + d) * l - x : kFar;  // slack above, along the axis
+  const float x_lo = ix - d + 1 > 0 ? x - float(ix - d + 1) * l : kFar;
+  const float r_hi = ir + d < m.nr ? float(ir + d) * l - r : kFar;
+  const float r_lo = ir - d + 1 > 0 ? r - float(ir - d + 1) * l : kFar;
+  // x is monotone along the ray: the side behind only needs the margin.
+  const float x_ahead = ray.dx > 0.0f ? x_hi : x_lo, x_behind = ray.dx > 0.0f ? x_lo : x_hi;
+  const float r_slack = fminf(r_hi, r_lo);
+  if (x_behind <= eps || x_ahead <= eps || r_slack <= eps) return 0.0f;
+  const float reach_x = x_ahead >= kFar ? kFar : (x_ahead - eps) * inv_dx;  // inv_dx = 1/|dx| (inf when 0)
+  const float reach_r = r_slack >= kFar ? kFar : (r_slack - eps) * inv_wd;
+  return fminf(reach_x, reach_r);
+}
+
 }  // namespace axial_detail
 
-// One ray through the axial map: radiance and transmittance per band.
-// `visited` (may be null) counts the samples the loop stepped through.
+// One ray through the axial map: radiance and transmittance per band. The
+// skip mode (s.skip is not read) and whether there are stars are fixed at
+// compile time, so each kernel holds only what its scene needs (a scene
+// without stars carries no table lookups in its registers). `visited` (may
+// be null) counts the samples the loop stepped through.
+template <AxialSkip kMode, bool kStars>
 NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 dir, int* visited = nullptr) {
   RayResult out{};
   for (int b = 0; b < kMaxBands; ++b) out.transmittance[b] = 1.0f;
@@ -191,7 +223,7 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
   // sample positions (a few ulps of the coordinates' magnitude).
   const float scale = length(origin - m.origin) + t_out + m.length() + m.radius();
   const float eps = 1e-3f * m.texel + 1e-5f * scale;
-  const int skip = static_cast<int>(s.skip);
+  constexpr int skip = static_cast<int>(kMode);
   if (skip >= int(AxialSkip::GlobalMax)) {
     if (m.global_max == 0) return out;
     float ta, tb;
@@ -202,6 +234,8 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
     k_end = last < n_samples - 1.0f ? static_cast<int>(fmaxf(last, 0.0f)) + 1 : K;
   }
   const int omega_large = (k_end - k_begin) / 32;
+  const float inv_dx = 1.0f / fabsf(ray.dx), inv_wd = 1.0f / length(ray.wd);  // inf when 0
+  const float inv_h = 1.0f / h;
   const float inv_texel = 1.0f / m.texel;
   const Vec3 to_eye = -dir;
   bool previous_empty = false;
@@ -227,7 +261,13 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
     const float fx = floorf(x * inv_texel), fr = floorf(r * inv_texel);
     bool empty = !(fx >= 0.0f && fx < float(m.nx) && fr < float(m.nr));  // outside (or NaN)
     const int ix = empty ? 0 : static_cast<int>(fx), ir = empty ? 0 : static_cast<int>(fr);
-    if (!empty && skip >= int(AxialSkip::Empty)) empty = ir >= m.height[ix] || ir < m.floor[ix];
+    int distance = 0;  // the sample's texel's, Distance mode only
+    if (!empty && skip == int(AxialSkip::Distance)) {
+      distance = m.distance[m.index(ix, ir)];
+      empty = distance != 0;
+    } else if (!empty && skip >= int(AxialSkip::Empty)) {
+      empty = ir >= m.height[ix] || ir < m.floor[ix];
+    }
     if (skip == int(AxialSkip::Naive) || !empty) {
       float tau_v = 0.0f;
       float source[kMaxBands] = {};
@@ -242,7 +282,7 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
           dark = dark && source[b] == 0.0f;
         }
         dark = dark && tau_v == 0.0f;
-        if (tau_v > 0.0f) {
+        if (kStars && tau_v > 0.0f) {
           for (int k_star = 0; k_star < s.n_stars; ++k_star)
             add_star_light(s, s.stars[k_star].position, s.stars[k_star].power, s.stars[k_star].depth_v[cell], pos,
                            tau_v, m.texel, to_eye, source, &out.table_clamps);
@@ -272,6 +312,15 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
     const bool gap_start = !previous_empty;
     previous_empty = empty;
     if (!empty || skip < int(AxialSkip::Omega)) continue;
+    if (skip == int(AxialSkip::Distance)) {
+      // Every sample within reach is empty: jump over all of them.
+      if (distance == 0) continue;  // outside the map: no texel, no distance
+      const float reach = axial_detail::distance_reach(m, ray, inv_dx, inv_wd, x, r, ix, ir, distance, eps);
+      // reach * (1/h) may round up by an ulp of reach: far inside the margin eps.
+      const float n = fminf(floorf(reach * inv_h), float(k_end - 1 - k));
+      if (n >= 1.0f) k += static_cast<int>(n);
+      continue;
+    }
     // From an empty sample k: skip samples k+1 .. k+n when the stretch from
     // sample k's position to sample k+n's is empty. After a failed attempt the
     // next ones wait (1, 2, 4, ... up to 32 empty samples), so the hollow
@@ -314,6 +363,25 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
     }
   }
   return out;
+}
+
+// Calls f(mode, stars) with std::integral_constant / std::bool_constant for
+// the run-time mode and whether the scene has stars: the one place that
+// turns them into template arguments (the CPU loop, the CUDA launch).
+template <class F>
+decltype(auto) dispatch_axial(AxialSkip mode, bool stars, F&& f) {
+  auto with_stars = [&](auto m) -> decltype(auto) {
+    return stars ? f(m, std::true_type{}) : f(m, std::false_type{});
+  };
+  switch (mode) {
+    case AxialSkip::Naive: return with_stars(std::integral_constant<AxialSkip, AxialSkip::Naive>{});
+    case AxialSkip::Empty: return with_stars(std::integral_constant<AxialSkip, AxialSkip::Empty>{});
+    case AxialSkip::GlobalMax: return with_stars(std::integral_constant<AxialSkip, AxialSkip::GlobalMax>{});
+    case AxialSkip::Omega: return with_stars(std::integral_constant<AxialSkip, AxialSkip::Omega>{});
+    case AxialSkip::OmegaMulti: return with_stars(std::integral_constant<AxialSkip, AxialSkip::OmegaMulti>{});
+    case AxialSkip::Distance: break;
+  }
+  return with_stars(std::integral_constant<AxialSkip, AxialSkip::Distance>{});
 }
 
 }  // namespace nebula

@@ -12,7 +12,8 @@ namespace {
 
 using testing::AxialScene;
 
-constexpr AxialSkip kSkips[] = {AxialSkip::Empty, AxialSkip::GlobalMax, AxialSkip::Omega, AxialSkip::OmegaMulti};
+constexpr AxialSkip kSkips[] = {AxialSkip::Empty, AxialSkip::GlobalMax, AxialSkip::Omega, AxialSkip::OmegaMulti,
+                                AxialSkip::Distance};
 
 AxialView unit_map(int nx, int nr, float texel) {
   AxialView v;
@@ -118,6 +119,42 @@ TEST(AxialMap, HeightMapIsTheHighestNonEmptyTexel) {
   EXPECT_GT(double(empty) / thin.count(), 0.9) << "the thin map is mostly empty";
 }
 
+// The two-pass transform against the definition, on maps with scattered
+// texels, one texel, none, and distances beyond the cap.
+TEST(AxialMap, DistanceMapIsTheChebyshevDistanceToTheNearestNonEmptyTexel) {
+  auto brute = [](const AxialMap& m, int ix, int ir) {
+    int best = kAxialMaxDistance;
+    for (int jr = 0; jr < m.nr; ++jr)
+      for (int jx = 0; jx < m.nx; ++jx)
+        if (!m.empty_at(m.index(jx, jr))) best = std::min(best, std::max(std::abs(jx - ix), std::abs(jr - ir)));
+    return best;
+  };
+  std::vector<AxialMap> maps;
+  for (const std::string& name : synthetic_axial_map_names()) maps.push_back(synthetic_axial_map(name, 41, 17, 1.0f, 1));
+  AxialMap dot = synthetic_axial_map("empty", 300, 7, 1.0f);  // one texel: distances up to 297 pass the cap
+  dot.tau_v[dot.index(2, 5)] = 0.1f;
+  dot.update_skip_structures();
+  maps.push_back(dot);
+  AxialMap scattered = synthetic_axial_map("empty", 23, 19, 1.0f, 1);
+  uint32_t state = 12345;
+  for (int k = 0; k < 9; ++k) {
+    state = state * 1664525u + 1013904223u;
+    scattered.emission[0][state % scattered.count()] = 1.0f;  // emission alone makes a texel non-empty
+  }
+  scattered.update_skip_structures();
+  maps.push_back(scattered);
+  for (size_t k = 0; k < maps.size(); ++k) {
+    const AxialMap& m = maps[k];
+    ASSERT_EQ(m.distance.size(), m.count());
+    for (int ir = 0; ir < m.nr; ++ir)
+      for (int ix = 0; ix < m.nx; ++ix)
+        ASSERT_EQ(int(m.distance[m.index(ix, ir)]), brute(m, ix, ir)) << "map " << k << " at " << ix << ", " << ir;
+  }
+  EXPECT_EQ(int(dot.distance[dot.index(299, 0)]), kAxialMaxDistance);  // 297 away: capped
+  EXPECT_EQ(int(dot.distance[dot.index(200, 0)]), 198);
+  EXPECT_EQ(int(maps[3].distance[0]), kAxialMaxDistance);  // the empty map: no dust anywhere
+}
+
 bool identical(const Image& a, const Image& b) {
   return a.pixels.size() == b.pixels.size() &&
          std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(float)) == 0;
@@ -216,21 +253,35 @@ TEST(AxialSkipping, HardRaysAreBitIdenticalToo) {
 }
 
 // The skipping modes do skip: samples visited on the thin map at 45 degrees,
-// each mode no more than the one before it, omega_multi a small fraction of naive.
+// each of the thesis' modes no more than the one before it, omega_multi a
+// small fraction of naive, and the distance mode fewer than global_max (whose
+// clipping it shares) on the thin map and on the hollow shells.
 TEST(AxialSkipping, ModesReadFewerTexels) {
-  AxialScene s("bipolar", 128, 48);
-  s.inputs.camera = s.view(45, 32, 0);
-  uint64_t previous = ~uint64_t(0), naive = 0;
-  for (AxialSkip mode : {AxialSkip::Naive, AxialSkip::Empty, AxialSkip::GlobalMax, AxialSkip::Omega, AxialSkip::OmegaMulti}) {
-    s.inputs.skip = mode;
-    AxialRenderStats stats;
-    render_axial_cpu(s.inputs, &stats);
-    std::printf("%-12s %llu samples visited\n", to_string(mode), (unsigned long long)stats.samples);
-    if (mode == AxialSkip::Naive) naive = stats.samples;
-    EXPECT_LE(stats.samples, previous) << to_string(mode);
-    previous = stats.samples;
+  for (const std::string name : {"bipolar", "shells"}) {
+    AxialScene s(name, 128, 48);
+    s.inputs.camera = s.view(45, 32, 0);
+    uint64_t previous = ~uint64_t(0), naive = 0, global_max = 0;
+    for (AxialSkip mode : axial_skip_modes()) {
+      s.inputs.skip = mode;
+      AxialRenderStats stats;
+      render_axial_cpu(s.inputs, &stats);
+      std::printf("%-8s %-12s %llu samples visited\n", name.c_str(), to_string(mode), (unsigned long long)stats.samples);
+      if (mode == AxialSkip::Naive) naive = stats.samples;
+      if (mode == AxialSkip::GlobalMax) global_max = stats.samples;
+      if (mode == AxialSkip::Distance) {
+        EXPECT_LT(stats.samples, global_max) << name;
+        if (name == "bipolar") {
+          EXPECT_LT(stats.samples * 10, naive);
+        }
+      } else {
+        EXPECT_LE(stats.samples, previous) << name << " " << to_string(mode);
+        previous = stats.samples;
+      }
+    }
+    if (name == "bipolar") {
+      EXPECT_LT(previous * 5, naive);
+    }
   }
-  EXPECT_LT(previous * 5, naive);
 }
 
 // A coarse step (larger than a texel) and a fine one: the skip arithmetic

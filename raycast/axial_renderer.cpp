@@ -19,14 +19,24 @@ const char* to_string(AxialSkip mode) {
     case AxialSkip::GlobalMax: return "global_max";
     case AxialSkip::Omega: return "omega";
     case AxialSkip::OmegaMulti: return "omega_multi";
+    case AxialSkip::Distance: return "distance";
   }
   return "?";
 }
 
+const std::vector<AxialSkip>& axial_skip_modes() {
+  static const std::vector<AxialSkip> modes{AxialSkip::Naive, AxialSkip::Empty, AxialSkip::GlobalMax,
+                                            AxialSkip::Omega, AxialSkip::OmegaMulti, AxialSkip::Distance};
+  return modes;
+}
+
 AxialSkip parse_axial_skip(const std::string& text, const std::string& option) {
-  for (AxialSkip m : {AxialSkip::Naive, AxialSkip::Empty, AxialSkip::GlobalMax, AxialSkip::Omega, AxialSkip::OmegaMulti})
+  std::string known;
+  for (AxialSkip m : axial_skip_modes()) {
     if (text == to_string(m)) return m;
-  throw Error(option + ": '" + text + "' is not a skip mode (known: naive, empty, global_max, omega, omega_multi)");
+    known += (known.empty() ? "" : ", ") + std::string(to_string(m));
+  }
+  throw Error(option + ": '" + text + "' is not a skip mode (known: " + known + ")");
 }
 
 AxialSkip effective_skip(const AxialRenderInputs& in) {
@@ -94,21 +104,24 @@ Image render_axial_cpu(const AxialRenderInputs& in, AxialRenderStats* stats) {
   Image image(in.camera.width, in.camera.height, names);
   std::atomic<uint64_t> clamps{0}, reads{0};
   const auto start = std::chrono::steady_clock::now();
-  tbb::parallel_for(tbb::blocked_range<int>(0, in.camera.height), [&](const auto& rows) {
-    uint64_t local = 0, local_reads = 0;
-    for (int y = rows.begin(); y != rows.end(); ++y)
-      for (int x = 0; x < in.camera.width; ++x) {
-        Vec3 origin, dir;
-        if (!in.camera.ray(x, y, origin, dir)) continue;
-        int visited = 0;
-        const RayResult r = march_axial_ray(scene, origin, dir, &visited);
-        local_reads += uint64_t(visited);
-        for (int b = 0; b < scene.n_bands; ++b) image.at(b, x, y) = in.exposure * r.radiance[b];
-        local += uint64_t(r.table_clamps);
-      }
-    clamps += local;
-    reads += local_reads;
-    if (in.progress) in.progress->add(rows.size());
+  dispatch_axial(scene.skip, scene.n_stars > 0, [&](auto mode, auto has_stars) {
+    tbb::parallel_for(tbb::blocked_range<int>(0, in.camera.height), [&](const auto& rows) {
+      uint64_t local = 0, local_reads = 0;
+      for (int y = rows.begin(); y != rows.end(); ++y)
+        for (int x = 0; x < in.camera.width; ++x) {
+          Vec3 origin, dir;
+          if (!in.camera.ray(x, y, origin, dir)) continue;
+          int visited = 0;
+          const RayResult r =
+              march_axial_ray<decltype(mode)::value, decltype(has_stars)::value>(scene, origin, dir, &visited);
+          local_reads += uint64_t(visited);
+          for (int b = 0; b < scene.n_bands; ++b) image.at(b, x, y) = in.exposure * r.radiance[b];
+          local += uint64_t(r.table_clamps);
+        }
+      clamps += local;
+      reads += local_reads;
+      if (in.progress) in.progress->add(rows.size());
+    });
   });
   if (stats) {
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -56,7 +56,9 @@ float effective_step(const AxialRenderInputs& in);
 // The mode the march runs: in.skip, except the naive march when the map has
 // no empty texel (nothing can be skipped, so the checks would only cost).
 AxialSkip effective_skip(const AxialRenderInputs& in);
-// "naive", "empty", "global_max", "omega", "omega_multi"; Error naming `option` otherwise.
+// Every mode, naive first.
+const std::vector<AxialSkip>& axial_skip_modes();
+// "naive", "empty", "global_max", "omega", "omega_multi", "distance"; Error naming `option` otherwise.
 AxialSkip parse_axial_skip(const std::string& text, const std::string& option);
 
 Image render_axial(const AxialRenderInputs& in, Backend backend, AxialRenderStats* stats = nullptr);

@@ -20,14 +20,18 @@ namespace {
 #define NEBULA_AXIAL_MIN_BLOCKS 3  // with the band loops unrolled, at most 80 registers: 15-35% faster (H100, docs/performance.md)
 #endif
 
-__global__ void __launch_bounds__(256, NEBULA_AXIAL_MIN_BLOCKS) axial_kernel(AxialMarchScene scene, Camera camera, float exposure, float* pixels,
-                             unsigned long long* clamps) {
+// One instantiation per skip mode and star use: each kernel holds only its
+// mode's checks and gets its own register allocation; the physics is the
+// same template.
+template <AxialSkip kMode, bool kStars>
+__global__ void __launch_bounds__(256, NEBULA_AXIAL_MIN_BLOCKS)
+    axial_kernel(AxialMarchScene scene, Camera camera, float exposure, float* pixels, unsigned long long* clamps) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x;
   const int y = blockIdx.y * blockDim.y + threadIdx.y;
   if (x >= camera.width || y >= camera.height) return;
   Vec3 origin, dir;
   if (!camera.ray(x, y, origin, dir)) return;
-  const RayResult r = march_axial_ray(scene, origin, dir);
+  const RayResult r = march_axial_ray<kMode, kStars>(scene, origin, dir);
   const size_t plane = size_t(camera.width) * camera.height;
   NEBULA_UNROLL
   for (int b = 0; b < kMaxBands; ++b)
@@ -54,6 +58,9 @@ Image render_axial_cuda(const AxialRenderInputs& in, AxialRenderStats* stats) {
   for (size_t b = 0; b < m.emission.size(); ++b) scene.map.emission[b] = upload(m.emission[b]);
   DeviceArray<int> height(m.height), floor(m.floor), tree(m.tree), floor_tree(m.floor_tree);
   bytes += height.bytes() + floor.bytes() + tree.bytes() + floor_tree.bytes();
+  DeviceArray<uint8_t> distance(m.distance);
+  bytes += distance.bytes();
+  scene.map.distance = distance.get();
   scene.map.height = height.get();
   scene.map.floor = floor.get();
   scene.map.tree = tree.get();
@@ -89,9 +96,16 @@ Image render_axial_cuda(const AxialRenderInputs& in, AxialRenderStats* stats) {
   Image image(in.camera.width, in.camera.height, names);
   DeviceArray<float> pixels(image.pixels.size());
   DeviceArray<unsigned long long> clamps(1);
-  const dim3 block(16, 16), grid((in.camera.width + 15) / 16, (in.camera.height + 15) / 16);
+#ifndef NEBULA_AXIAL_BLOCK_X
+#define NEBULA_AXIAL_BLOCK_X 16
+#endif
+  constexpr int bx = NEBULA_AXIAL_BLOCK_X, by = 256 / bx;
+  const dim3 block(bx, by), grid((in.camera.width + bx - 1) / bx, (in.camera.height + by - 1) / by);
   CudaEventTimer timer;
-  axial_kernel<<<grid, block>>>(scene, in.camera, in.exposure, pixels.get(), clamps.get());
+  dispatch_axial(scene.skip, scene.n_stars > 0, [&](auto mode, auto has_stars) {
+    axial_kernel<decltype(mode)::value, decltype(has_stars)::value>
+        <<<grid, block>>>(scene, in.camera, in.exposure, pixels.get(), clamps.get());
+  });
   NEBULA_CUDA_CHECK(cudaGetLastError());
   const double seconds = timer.seconds();
   NEBULA_CUDA_CHECK(cudaMemcpy(image.pixels.data(), pixels.get(), image.pixels.size() * sizeof(float),

@@ -62,7 +62,8 @@ TEST(AxialRendererGpu, SkippingModesMatchNaiveAndTheCpu) {
         EXPECT_LE(c.mean, 1e-4 * c.peak) << name << " " << inc;
         EXPECT_LE(c.worst, 0.25 * c.peak) << name << " " << inc;
         for (float v : naive.pixels) ASSERT_TRUE(std::isfinite(v));
-        for (AxialSkip mode : {AxialSkip::Empty, AxialSkip::GlobalMax, AxialSkip::Omega, AxialSkip::OmegaMulti}) {
+        for (AxialSkip mode : {AxialSkip::Empty, AxialSkip::GlobalMax, AxialSkip::Omega, AxialSkip::OmegaMulti,
+                               AxialSkip::Distance}) {
           s.inputs.skip = mode;
           const Difference d = compare(render_axial_cuda(s.inputs, nullptr), naive);
           EXPECT_LE(d.worst, 1e-6 * d.peak) << name << " " << inc << " " << to_string(mode);

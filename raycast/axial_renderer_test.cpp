@@ -67,7 +67,7 @@ TEST(AxialRender, UniformCylinderMatchesTheClosedForm) {
     in.step = h;
     for (const View& v : views) {
       in.camera = v.camera;
-      for (AxialSkip mode : {AxialSkip::Naive, AxialSkip::OmegaMulti}) {
+      for (AxialSkip mode : {AxialSkip::Naive, AxialSkip::OmegaMulti, AxialSkip::Distance}) {
         in.skip = mode;
         const Image image = render_axial_cpu(in, nullptr);
         for (int b = 0; b < 2; ++b) {
@@ -194,6 +194,15 @@ TEST(AxialRender, RefusesBadInputs) {
   EXPECT_THROW(synthetic_axial_map("spiral", 8, 8, 1.0f), Error);
   EXPECT_THROW(parse_axial_skip("fast", "--skip"), Error);
   EXPECT_EQ(parse_axial_skip("omega_multi", "--skip"), AxialSkip::OmegaMulti);
+  EXPECT_EQ(parse_axial_skip("distance", "--skip"), AxialSkip::Distance);
+  try {
+    parse_axial_skip("fast", "--skip");
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--skip: 'fast' is not a skip mode (known: naive, empty, global_max, omega, "
+                                         "omega_multi, distance)"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

@@ -499,9 +499,10 @@ AxialSpec Parser::parse_axial(const toml::table& root, const std::vector<std::st
   }
   if (const toml::node* v = t.get("skip")) {
     a.skip = string(*v, "axial.skip");
-    const char* modes[] = {"naive", "empty", "global_max", "omega", "omega_multi"};
+    const char* modes[] = {"naive", "empty", "global_max", "omega", "omega_multi", "distance"};
     if (std::find_if(std::begin(modes), std::end(modes), [&](const char* m) { return a.skip == m; }) == std::end(modes))
-      fail("axial.skip", "'" + a.skip + "' is not a skip mode (known: naive, empty, global_max, omega, omega_multi)");
+      fail("axial.skip",
+           "'" + a.skip + "' is not a skip mode (known: naive, empty, global_max, omega, omega_multi, distance)");
   }
   return a;
 }

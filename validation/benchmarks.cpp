@@ -252,7 +252,11 @@ TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int 
 
 void bench_axial(Backend backend, int map_size, int width, int height, int repeats, float step_texels,
                  const std::vector<std::string>& maps, const std::vector<int>& inclinations, bool star,
-                 const std::function<void(const AxialBenchRow&)>& on_row, bool step_aside) {
+                 const std::function<void(const AxialBenchRow&)>& on_row, bool step_aside,
+                 std::vector<AxialSkip> modes) {
+  if (modes.empty()) modes = axial_skip_modes();
+  modes.erase(std::remove(modes.begin(), modes.end(), AxialSkip::Naive), modes.end());
+  modes.insert(modes.begin(), AxialSkip::Naive);
   ScatteringTable table;
   if (star) {
     TabulateParams tp;
@@ -293,8 +297,7 @@ void bench_axial(Backend backend, int map_size, int width, int height, int repea
       in.camera = make_camera(cs);
       Image naive;
       double naive_ms = 0;
-      for (AxialSkip mode : {AxialSkip::Naive, AxialSkip::Empty, AxialSkip::GlobalMax, AxialSkip::Omega,
-                             AxialSkip::OmegaMulti}) {
+      for (AxialSkip mode : modes) {
         in.skip = mode;
         AxialRenderStats stats;
         Image image = render_axial(in, backend, &stats);  // warm-up

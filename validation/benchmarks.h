@@ -103,6 +103,8 @@ TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int 
 
 #include <functional>
 
+#include "raycast/axial_march.h"
+
 namespace nebula {
 
 struct AxialBenchRow {
@@ -118,7 +120,8 @@ struct AxialBenchRow {
 // The thesis' Tables 5.1-5.5 (Khalass 2021): each synthetic map of
 // map_size x map_size texels (1 pc along the axis), seen by an orthographic
 // camera of width x height pixels framing the map at each inclination,
-// rendered in every skip mode (naive first) at a step of step_texels; one
+// rendered in each of `modes` (empty: every one; naive always runs first, as
+// the reference of the speed-ups and differences) at a step of step_texels; one
 // warm-up, then the median of `repeats`. With `star`, a B-type star on the
 // axis at the map's centre lights the dust (full physics, a = g = 0.6, three
 // bands); without it, emission-absorption only. Rows go to on_row as they come.
@@ -126,6 +129,7 @@ struct AxialBenchRow {
 // measure its overhead there).
 void bench_axial(Backend backend, int map_size, int width, int height, int repeats, float step_texels,
                  const std::vector<std::string>& maps, const std::vector<int>& inclinations, bool star,
-                 const std::function<void(const AxialBenchRow&)>& on_row, bool step_aside = true);
+                 const std::function<void(const AxialBenchRow&)>& on_row, bool step_aside = true,
+                 std::vector<AxialSkip> modes = {});
 
 }  // namespace nebula
