@@ -37,7 +37,7 @@ struct AxialRenderInputs {
   float exposure = 1.0f;
   float min_transmittance = 1e-4f;
   float step = 0;  // h in world units; 0 means half a texel
-  AxialSkip skip = AxialSkip::OmegaMulti;
+  AxialSkip skip = AxialSkip::Distance;
   bool step_aside = true;  // march naively when the map has no empty texel (effective_skip)
   Progress* progress = nullptr;  // CPU only, advanced in image rows; may be null
 };

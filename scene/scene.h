@@ -68,7 +68,7 @@ struct AxialSpec {
   double emission_scale = 1.0;     // multiplies emission (0: none)
   Vec3 origin{0, 0, 0};            // the axis point where the map starts (x = 0)
   Vec3 axis{0, 0, 1};              // unit direction of +x
-  std::string skip = "omega_multi";
+  std::string skip = "distance";
   double step_texels = 0.5;        // the march's step h in texels
 };
 

@@ -595,7 +595,7 @@ TEST_F(AxialSceneFile, LoadsWithDefaultsAndANormalisedAxis) {
   EXPECT_EQ(s.axial->nx, 64);
   EXPECT_EQ(s.axial->nr, 32);
   EXPECT_FLOAT_EQ(s.axial->axis.z, 1.0f);
-  EXPECT_EQ(s.axial->skip, "omega_multi");
+  EXPECT_EQ(s.axial->skip, "distance");
   EXPECT_EQ(s.axial->step_texels, 0.5);
   EXPECT_EQ(s.density.tau_v.size(), 0u);
   EXPECT_NO_THROW(validate_scene(s));
