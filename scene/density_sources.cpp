@@ -334,12 +334,20 @@ DensityGrid load_density_fits(const std::string& path, double voxel_size_pc) {
     throw Error(what + ": has " + std::to_string(found) + " of CDELT1, CDELT2, CDELT3; give all three or none");
   double voxel = 0;
   if (found == 3) {
+    // Signs first: a negative step is a flipped axis, whatever the sizes say.
+    static const char* const kAxis[3] = {"x", "y", "z"};
+    for (int a = 0; a < 3; ++a) {
+      const std::string key = "CDELT" + std::to_string(a + 1) + " = " + to_text(cdelt[a]);
+      if (cdelt[a] < 0)
+        throw Error(what + ": " + key + ": the " + kAxis[a] +
+                    " axis is flipped (a negative step), which is not supported; store the data in "
+                    "ascending order with a positive CDELT" + std::to_string(a + 1));
+      if (!(cdelt[a] > 0)) throw Error(what + ": " + key + ": a voxel size must be positive");
+    }
     for (int a = 1; a < 3; ++a)
       if (std::fabs(cdelt[a] - cdelt[0]) > 1e-6 * std::fabs(cdelt[0]))
         throw Error(what + ": voxels must be cubes, but CDELT1 = " + to_text(cdelt[0]) + " and CDELT" +
                     std::to_string(a + 1) + " = " + to_text(cdelt[a]));
-    if (!(cdelt[0] > 0))
-      throw Error(what + ": CDELT1 = " + to_text(cdelt[0]) + " must be positive (flipped axes are not supported)");
     voxel = cdelt[0];
     if (voxel_size_pc > 0 && std::fabs(voxel_size_pc - voxel) > 1e-6 * voxel)
       throw Error(what + ": the scene's voxel size " + to_text(voxel_size_pc) +

@@ -219,7 +219,16 @@ TEST_F(DensityFiles, FitsRefusesBadHeaders) {
   expect_error([&] { load_density_fits(path("uneven.fits")); }, {"uneven.fits", "CDELT3", "cubes"});
 
   write_fits(path("neg.fits"), {2, 3, 4}, ones, FLOAT_IMG, cdelt(-0.2));
-  expect_error([&] { load_density_fits(path("neg.fits")); }, {"neg.fits", "CDELT1", "positive"});
+  expect_error([&] { load_density_fits(path("neg.fits")); }, {"neg.fits", "CDELT1", "flipped", "positive"});
+  // One flipped axis is named as such, not taken for a voxel that is no cube.
+  FitsKeys flipped_x = cdelt(0.2);
+  flipped_x.numbers["CDELT1"] = -0.2;
+  write_fits(path("flipped.fits"), {2, 3, 4}, ones, FLOAT_IMG, flipped_x);
+  expect_error([&] { load_density_fits(path("flipped.fits")); }, {"flipped.fits", "CDELT1 = -0.2", "x axis is flipped"});
+  FitsKeys flipped_z = cdelt(0.2);
+  flipped_z.numbers["CDELT3"] = -0.2;
+  write_fits(path("flipped_z.fits"), {2, 3, 4}, ones, FLOAT_IMG, flipped_z);
+  expect_error([&] { load_density_fits(path("flipped_z.fits")); }, {"CDELT3 = -0.2", "z axis is flipped"});
 
   FitsKeys degrees = cdelt(0.2);
   degrees.strings["CUNIT2"] = "deg";

@@ -1,0 +1,39 @@
+#pragma once
+// The bands one render carries, and what the dust and the stars do in each
+// (DESIGN.md section 3, "Bands"). A band is named by its filter ("B", "V", "R";
+// the filter registry, illumination/filters.h, knows which names exist); every
+// renderer takes its bands and stars as these types, adding only what it reads
+// itself (tables, emission grids, baked depths).
+#include <string>
+#include <vector>
+
+#include "core/vec3.h"
+
+namespace nebula {
+
+// The most bands one render carries: kernels keep per-band arrays of this
+// size in registers (DESIGN.md, "Band loops in kernels").
+constexpr int kMaxBands = 4;
+
+// One band: its filter and the dust's optical properties in it.
+struct Band {
+  std::string name;            // the filter's name, e.g. "V"
+  float extinction_ratio = 1;  // A_b / A_V: tau_b = tau_v * extinction_ratio
+  float albedo = 0.6f;         // single-scattering albedo a_b; 0: the band does not scatter
+  float g = 0.6f;              // Henyey-Greenstein asymmetry g_b
+};
+
+// A point star as every renderer sees it: where it is and its power per band
+// (L_sun inside each band, in the bands' order).
+struct StarLight {
+  Vec3 position;
+  std::vector<float> power;
+};
+
+// A star with its baked V-band optical depth to every cell of the volume a
+// renderer marches (voxels of a grid, texels of an axial map).
+struct BakedStar : StarLight {
+  const std::vector<float>* depth_v = nullptr;
+};
+
+}  // namespace nebula
