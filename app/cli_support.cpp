@@ -1,4 +1,4 @@
-#include "app/output_path.h"
+#include "app/cli_support.h"
 
 #include <unistd.h>
 
@@ -7,6 +7,9 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "core/gpu.h"
+#include "imageio/image_output.h"
+#include "scene/scene_file.h"
 
 namespace nebula::app {
 
@@ -24,6 +27,15 @@ void check_output_path(const std::string& option, const std::string& path, bool 
     throw Error(option + ": cannot write into folder " + dir.string() + " (permission denied)");
 }
 
+void check_image_output(const std::string& option, const std::string& path, bool overwrite) {
+  try {
+    check_image_format(path);
+  } catch (const Error& e) {
+    throw Error(option + ": " + e.what());
+  }
+  check_output_path(option, path, overwrite);
+}
+
 uint64_t parse_count(const std::string& option, const std::string& text, double lo, double hi) {
   size_t used = 0;
   double v = 0;
@@ -38,6 +50,53 @@ uint64_t parse_count(const std::string& option, const std::string& text, double 
     throw Error(option + ": expected a whole number from " + std::to_string(uint64_t(lo)) + " to " +
                 std::to_string(uint64_t(hi)) + ", got '" + text + "'");
   return static_cast<uint64_t>(v);
+}
+
+Backend parse_backend(const std::string& s, const std::string& option) {
+  if (s == "cpu") return Backend::Cpu;
+  if (s == "cuda" || s == "gpu") {
+    std::string why;
+    if (!gpu_available(&why)) throw Error(option + ": cuda requested but " + why);
+    return Backend::Cuda;
+  }
+  if (s == "auto") return gpu_available() ? Backend::Cuda : Backend::Cpu;
+  throw Error(option + ": expected cpu, cuda or auto, got '" + s + "'");
+}
+
+std::vector<Backend> bench_backends(const std::string& text) {
+  if (text == "both" || (text == "auto" && gpu_available())) return {Backend::Cpu, Backend::Cuda};
+  return {parse_backend(text)};
+}
+
+void add_scene_options(CLI::App* command, SceneOptions& o) {
+  command->add_option("SCENE", o.path, "scene file (docs/scene.md)");
+  command->add_flag("--demo", o.demo, "the built-in procedural nebula with an O-type star (scenes/demo.toml)");
+  command->add_option("--set", o.overrides, "KEY=VALUE scene override, e.g. camera.fov_deg=30 (repeatable)")
+      ->allow_extra_args(false);
+  command->add_option("--width", o.width, "image width (overrides the scene)");
+  command->add_option("--height", o.height, "image height (overrides the scene)");
+}
+
+Scene load_scene_options(const std::string& command, const SceneOptions& o) {
+  if (o.demo == !o.path.empty()) throw Error(command + ": give a SCENE.toml or --demo (one of them)");
+  if (o.demo && !o.overrides.empty())
+    throw Error("--set: the demo takes no overrides; copy scenes/demo.toml and pass it instead");
+  if (o.width < 0 || o.height < 0) throw Error("--width/--height: must be positive");
+  Scene scene = o.demo ? demo_scene() : load_scene(o.path, o.overrides);
+  if (o.width > 0) scene.camera.width = o.width;
+  if (o.height > 0) scene.camera.height = o.height;
+  return scene;
+}
+
+void naming_options(const OptionNames& options, const std::function<void()>& body, const std::string& context) {
+  try {
+    body();
+  } catch (const ParameterError& e) {
+    const auto option = options.find(e.parameter());
+    if (option != options.end()) throw Error(option->second + ": " + e.reason());
+    if (!context.empty()) throw Error(context + ": " + e.what());
+    throw;
+  }
 }
 
 }  // namespace nebula::app

@@ -47,7 +47,7 @@ expect_failure(text_table "text.h5" table info text.h5)
 set(ENV{NEBULA_CACHE_DIR} ${WORK}/cache)
 expect_failure(render_nothing "--demo" render -o bad.png)
 expect_failure(render_demo_set "--set" render --demo --set camera.fov_deg=30 -o bad.png)
-expect_failure(render_extension "unknown image format" render --demo -o bad.jpg)
+expect_failure(render_extension "unknown image extension" render --demo -o bad.jpg)
 file(WRITE ${WORK}/scene_with_typo.toml
      "[density]\nprocedural = { n = 8 }\n[[stars]]\nluminosity_lsun = 1.0\nclass = \"G2V\"\n[camera]\nzoom = 3\n")
 expect_failure(render_unknown_key "camera.zoom" render scene_with_typo.toml -o bad.h5)
@@ -71,12 +71,24 @@ if(at EQUAL -1 OR level_at EQUAL -1)
   message(FATAL_ERROR "render printed no account of what it computed (and its 2 pyramid levels): ${out}")
 endif()
 
+# --set takes one value each time: a scene file after it is the scene, not another override.
+execute_process(COMMAND ${NEBULA} render --set dust.g=0.8 ${SOURCE}/scenes/uniform_sphere.toml --width 8 --height 8
+                        --table-photons 2000 --backend cpu -q -o set_first.h5
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err WORKING_DIRECTORY ${WORK})
+string(FIND "${out}" "g 0.8" at)
+if(NOT rc EQUAL 0 OR at EQUAL -1)
+  message(FATAL_ERROR "render --set KEY=VALUE SCENE failed (${rc}): ${out} ${err}")
+endif()
+# An unknown command is named, with the nearest known one.
+expect_failure(unknown_command "'rendr' is not a command; did you mean 'render'?" rendr scene.toml)
+expect_failure(unknown_far_command "'paint' is not a command (commands: render, truth" paint)
+
 # The ground truth and the comparison: bad requests fail before any work, with one line.
 set(sphere ${SOURCE}/scenes/uniform_sphere.toml)
 expect_failure(truth_no_spp "--spp" truth ${sphere} -o bad.h5)
 expect_failure(truth_spp_one "--spp" truth ${sphere} --spp 1 -o bad.h5)
 expect_failure(truth_spp_text "--spp" truth ${sphere} --spp many -o bad.h5)
-expect_failure(truth_extension "unknown image format" truth ${sphere} --spp 4 -o bad.jpg)
+expect_failure(truth_extension "unknown image extension" truth ${sphere} --spp 4 -o bad.jpg)
 expect_failure(truth_orders "--max-orders" truth ${sphere} --spp 4 --max-orders -1 -o bad.h5)
 expect_failure(truth_block "--majorant-block" truth ${sphere} --spp 4 --majorant-block 0 -o bad.h5)
 expect_failure(truth_missing_scene "missing.toml" truth missing.toml --spp 4 -o bad.h5)

@@ -4,8 +4,8 @@
 #include <string>
 #include <sys/stat.h>
 
+#include "app/cli_support.h"
 #include "app/commands.h"
-#include "app/output_path.h"
 #include "core/error.h"
 #include "imageio/image_output.h"
 #include "validation/image_compare.h"
@@ -31,14 +31,16 @@ void run_compare(const Options& o) {
     if (!openimageio_available()) throw Error("--diff: " + o.diff + ": .png needs OpenImageIO, which this build lacks");
     check_output_path("--diff", o.diff, o.force);
   }
-  if (!(o.signal >= 0 && o.signal < 1)) throw Error("--signal: must be in [0, 1)");
   const Image a = read_image(o.a), b = read_image(o.b);
   const std::string va = variance_path(o.a), vb = variance_path(o.b);
   Image var_a, var_b;
   const bool has_a = exists(va), has_b = exists(vb);
   if (has_a) var_a = read_image(va);
   if (has_b) var_b = read_image(vb);
-  const Comparison c = compare_images(a, b, has_a ? &var_a : nullptr, has_b ? &var_b : nullptr, o.signal, o.a, o.b);
+  Comparison c;
+  naming_options({{"signal_fraction", "--signal"}}, [&] {
+    c = compare_images(a, b, has_a ? &var_a : nullptr, has_b ? &var_b : nullptr, o.signal, o.a, o.b);
+  });
   std::vector<double> ranges;
   if (!o.diff.empty()) {
     ImageMetadata meta;

@@ -5,12 +5,12 @@
 #include <memory>
 #include <string>
 
+#include "app/cli_support.h"
 #include "app/commands.h"
-#include "app/output_path.h"
-#include "validation/table_conversion.h"
 #include "core/error.h"
 #include "core/math.h"
 #include "core/progress.h"
+#include "montecarlo/table_conversion.h"
 #include "montecarlo/tabulate.h"
 #include "tables/scattering_table.h"
 #include "tables/table_file.h"
@@ -119,7 +119,9 @@ void add_tabulate_command(CLI::App& app) {
     else if (o->illumination == "pencil") p.beam = Beam::Pencil;
     else throw Error("--illumination: expected parallel or pencil, got '" + o->illumination + "'");
     p.forced_first_scattering = !o->analog;
-    run_tabulate(p, o->backend, o->out, o->force, o->quiet);
+    naming_options({{"albedo", "--albedo"}, {"g", "--g"}, {"tau_max", "--tau-max"}, {"tau_bins", "--tau-bins"},
+                    {"mu_bins", "--mu-bins"}, {"photons_per_row", "--photons"}, {"backend", "--backend"}},
+                   [&] { run_tabulate(p, o->backend, o->out, o->force, o->quiet); });
   });
 }
 

@@ -1,4 +1,4 @@
-#include "illumination/axial_bake.h"
+#include "axial/axial_bake.h"
 
 #include "core/error.h"
 

@@ -1,4 +1,4 @@
-#include "raycast/axial_map.h"
+#include "axial/axial_map.h"
 
 #include <algorithm>
 #include <cmath>
@@ -96,7 +96,7 @@ AxialView AxialMap::view() const {
   v.origin = origin;
   v.axis = axis;
   v.tau_v = tau_v.data();
-  for (size_t b = 0; b < emission.size() && b < size_t(kAxialMaxBands); ++b) v.emission[b] = emission[b].data();
+  for (size_t b = 0; b < emission.size() && b < size_t(kMaxBands); ++b) v.emission[b] = emission[b].data();
   v.height = height.data();
   v.floor = floor.data();
   v.tree = tree.data();
@@ -126,7 +126,7 @@ void check_axial_map(const AxialMap& map, const std::string& what) {
   if (map.tau_v.size() != map.count())
     throw Error(what + ": tau_v has " + std::to_string(map.tau_v.size()) + " values, the map " +
                 std::to_string(map.count()));
-  if (map.emission.size() > size_t(kAxialMaxBands)) throw Error(what + ": at most 4 emission bands");
+  if (map.emission.size() > size_t(kMaxBands)) throw Error(what + ": at most 4 emission bands");
   auto check_values = [&](const std::vector<float>& v, const std::string& name) {
     if (v.size() != map.count())
       throw Error(what + ": " + name + " has " + std::to_string(v.size()) + " values, the map " +

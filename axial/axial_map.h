@@ -19,12 +19,12 @@
 #include <string>
 #include <vector>
 
+#include "core/bands.h"
 #include "core/hd.h"
 #include "core/vec3.h"
 
 namespace nebula {
 
-constexpr int kAxialMaxBands = 4;  // equals kMaxBands of ray_march.h
 constexpr int kAxialMaxTreeLevels = 32;
 constexpr int kAxialEmptyFloor = 1 << 30;  // the floor of an empty column: every r is below it
 constexpr int kAxialMaxDistance = 255;     // the distance map's cap (a lower bound beyond it)
@@ -36,7 +36,7 @@ struct AxialView {
   Vec3 origin;            // the axis point where x = 0
   Vec3 axis{0, 0, 1};     // unit direction of +x
   const float* tau_v = nullptr;                   // [ir * nx + ix]
-  const float* emission[kAxialMaxBands] = {};     // same layout, or null
+  const float* emission[kMaxBands] = {};     // same layout, or null
   const int* height = nullptr;                    // [ix], 0..nr
   const int* floor = nullptr;                     // [ix]: lowest non-empty r index, kAxialEmptyFloor for an empty column
   const int* tree = nullptr;                      // max-tree levels, level 0 = height padded

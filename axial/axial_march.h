@@ -1,5 +1,5 @@
 #pragma once
-// The fixed-step marcher through an axial map (raycast/AXIAL.md), written once
+// The fixed-step marcher through an axial map (docs/axial.md), written once
 // for host and device: the naive march ("NASR" in Khalass 2021) and four
 // exact empty-space skipping modes that only ever leave out samples that are
 // provably empty.
@@ -21,10 +21,10 @@
 #include <cmath>
 #include <type_traits>
 
+#include "axial/axial_map.h"
 #include "core/hd.h"
 #include "core/vec3.h"
 #include "illumination/optical_depth_bake.h"
-#include "raycast/axial_map.h"
 #include "raycast/ray_march.h"
 #include "tables/table_lookup.h"
 
@@ -44,19 +44,13 @@ enum class AxialSkip : int {
 
 const char* to_string(AxialSkip mode);
 
-struct AxialStarView {
-  Vec3 position;             // on the axis
-  float power[kMaxBands];    // band luminosity, L_sun
-  const float* depth_v;      // baked V-band depth to each texel's voxel sphere [ir * nx + ix]
-};
-
 struct AxialMarchScene {
   AxialView map;
   int n_bands = 0;
   float extinction_ratio[kMaxBands];
   float albedo[kMaxBands];
   TableView table[kMaxBands];
-  const AxialStarView* stars = nullptr;
+  const StarView* stars = nullptr;  // on the axis; depth_v per texel [ir * nx + ix]
   int n_stars = 0;
   float step = 1.0f;  // h, world units
   AxialSkip skip = AxialSkip::Distance;

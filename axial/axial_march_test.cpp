@@ -1,11 +1,11 @@
 // The axial marcher's geometry and the exactness of every skipping mode.
-#include "raycast/axial_march.h"
+#include "axial/axial_march.h"
 
 #include <gtest/gtest.h>
 
 #include <cstring>
 
-#include "raycast/axial_test_scenes.h"
+#include "axial/axial_test_scenes.h"
 
 namespace nebula {
 namespace {

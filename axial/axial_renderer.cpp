@@ -1,4 +1,4 @@
-#include "raycast/axial_renderer.h"
+#include "axial/axial_renderer.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -7,7 +7,9 @@
 #include <chrono>
 #include <cmath>
 
+#include "axial/axial_scene.h"
 #include "core/error.h"
+#include "core/placement.h"
 #include "core/progress.h"
 
 namespace nebula {
@@ -64,7 +66,7 @@ void validate(const AxialRenderInputs& in) {
     if (b.albedo > 0 && !in.stars.empty() && !b.table)
       throw Error("axial render: band " + b.name + " scatters but has no table");
   for (size_t k = 0; k < in.stars.size(); ++k) {
-    const AxialRenderStar& s = in.stars[k];
+    const BakedStar& s = in.stars[k];
     if (s.power.size() != in.bands.size()) throw Error("axial render: star " + std::to_string(k) + " lacks band powers");
     if (!s.depth_v || s.depth_v->size() != m.count())
       throw Error("axial render: star " + std::to_string(k) + " has no baked depth map");
@@ -77,31 +79,9 @@ void validate(const AxialRenderInputs& in) {
 }
 
 Image render_axial_cpu(const AxialRenderInputs& in, AxialRenderStats* stats) {
-  validate(in);
-  AxialMarchScene scene{};
-  scene.map = in.map->view();
-  scene.n_bands = static_cast<int>(in.bands.size());
-  scene.min_transmittance = in.min_transmittance;
-  scene.step = effective_step(in);
-  scene.skip = effective_skip(in);
-  for (int b = 0; b < scene.n_bands; ++b) {
-    const AxialRenderBand& band = in.bands[size_t(b)];
-    scene.extinction_ratio[b] = band.extinction_ratio;
-    scene.albedo[b] = band.table ? band.albedo : 0.0f;
-    scene.table[b] = band.table ? view_of(*band.table) : TableView{};
-  }
-  std::vector<AxialStarView> stars(in.stars.size());
-  for (size_t k = 0; k < stars.size(); ++k) {
-    stars[k].position = in.stars[k].position;
-    for (int b = 0; b < scene.n_bands; ++b) stars[k].power[b] = in.stars[k].power[size_t(b)];
-    stars[k].depth_v = in.stars[k].depth_v->data();
-  }
-  scene.stars = stars.data();
-  scene.n_stars = static_cast<int>(stars.size());
-
-  std::vector<std::string> names;
-  for (const AxialRenderBand& b : in.bands) names.push_back(b.name);
-  Image image(in.camera.width, in.camera.height, names);
+  HostPlacement host;
+  const AxialMarchScene scene = assemble_axial_scene(in, host);
+  Image image(in.camera.width, in.camera.height, band_names(in.bands));
   std::atomic<uint64_t> clamps{0}, reads{0};
   const auto start = std::chrono::steady_clock::now();
   dispatch_axial(scene.skip, scene.n_stars > 0, [&](auto mode, auto has_stars) {
@@ -115,7 +95,7 @@ Image render_axial_cpu(const AxialRenderInputs& in, AxialRenderStats* stats) {
           const RayResult r =
               march_axial_ray<decltype(mode)::value, decltype(has_stars)::value>(scene, origin, dir, &visited);
           local_reads += uint64_t(visited);
-          for (int b = 0; b < scene.n_bands; ++b) image.at(b, x, y) = in.exposure * r.radiance[b];
+          store_radiance(r, scene.n_bands, in.exposure, image.pixels.data(), image.width, image.height, x, y);
           local += uint64_t(r.table_clamps);
         }
       clamps += local;
@@ -128,7 +108,7 @@ Image render_axial_cpu(const AxialRenderInputs& in, AxialRenderStats* stats) {
     stats->table_clamps = clamps;
     stats->samples = reads;
     stats->skip_used = scene.skip;
-    stats->device_bytes = in.map->bytes() + in.stars.size() * in.map->count() * sizeof(float);
+    stats->device_bytes = host.bytes();
   }
   return image;
 }

@@ -1,38 +1,34 @@
 #pragma once
-// Renders an axial map (raycast/axial_map.h) lit by stars on its axis, on the
-// CPU (TBB, one task per image row) or the GPU (one CUDA thread per pixel);
-// both run march_axial_ray (axial_march.h).
+// Renders an axial map (axial_map.h) lit by stars on its axis, on the CPU
+// (TBB, one task per image row) or the GPU (one CUDA thread per pixel); both
+// run march_axial_ray (axial_march.h) over the scene assembled once by
+// assemble_axial_scene (axial_scene.h).
 #include <string>
 #include <vector>
 
+#include "axial/axial_map.h"
+#include "axial/axial_march.h"
 #include "core/backend.h"
+#include "core/bands.h"
+#include "core/camera.h"
 #include "core/image.h"
-#include "raycast/axial_map.h"
-#include "raycast/axial_march.h"
-#include "raycast/camera.h"
 #include "tables/scattering_table.h"
 
 namespace nebula {
 
 class Progress;
 
-struct AxialRenderBand {
-  std::string name;
-  float extinction_ratio = 1;  // A_b / A_V
-  float albedo = 0.6f;
-  const ScatteringTable* table = nullptr;  // required when albedo > 0 and there are stars
-};
-
-struct AxialRenderStar {
-  Vec3 position;                      // on the map's axis
-  std::vector<float> power;           // per band, L_sun
-  const std::vector<float>* depth_v;  // baked V-band depth per texel (illumination/axial_bake.h)
+// A band as the axial marcher reads it (its emission is in the map). It
+// scatters where it has a table; one is required when albedo > 0 and there
+// are stars.
+struct AxialRenderBand : Band {
+  const ScatteringTable* table = nullptr;
 };
 
 struct AxialRenderInputs {
   const AxialMap* map = nullptr;  // emission, if any, per band in the bands' order
   std::vector<AxialRenderBand> bands;
-  std::vector<AxialRenderStar> stars;
+  std::vector<BakedStar> stars;  // on the map's axis; depth_v per texel (axial_bake.h)
   Camera camera;
   float exposure = 1.0f;
   float min_transmittance = 1e-4f;

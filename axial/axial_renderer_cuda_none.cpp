@@ -1,10 +1,8 @@
-#include "core/error.h"
-#include "raycast/axial_renderer.h"
+#include "axial/axial_renderer.h"
+#include "core/gpu.h"
 
 namespace nebula {
 
-Image render_axial_cuda(const AxialRenderInputs&, AxialRenderStats*) {
-  throw Error("--backend cuda: this build has no CUDA backend (configured without a CUDA compiler)");
-}
+Image render_axial_cuda(const AxialRenderInputs&, AxialRenderStats*) { no_cuda_backend(); }
 
 }  // namespace nebula

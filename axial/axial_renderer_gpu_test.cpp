@@ -6,7 +6,7 @@
 #include <cstdio>
 
 #include "core/gpu.h"
-#include "raycast/axial_test_scenes.h"
+#include "axial/axial_test_scenes.h"
 
 namespace nebula {
 namespace {

@@ -1,13 +1,13 @@
 // The axial renderer's physics: emission-absorption against closed forms,
 // the same nebula voxelized to a 3D grid, and refused inputs.
-#include "raycast/axial_renderer.h"
+#include "axial/axial_renderer.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "core/error.h"
-#include "raycast/axial_test_scenes.h"
+#include "axial/axial_test_scenes.h"
 #include "raycast/renderer.h"
 
 namespace nebula {
@@ -55,7 +55,7 @@ TEST(AxialRender, UniformCylinderMatchesTheClosedForm) {
   AxialMap m = uniform_cylinder(40, 10, texel, tau, j);
   AxialRenderInputs in;
   in.map = &m;
-  in.bands = {AxialRenderBand{"B", 1.3f, 0.0f, nullptr}, AxialRenderBand{"V", 1.0f, 0.0f, nullptr}};
+  in.bands = {AxialRenderBand{{"B", 1.3f, 0.0f}, nullptr}, AxialRenderBand{{"V", 1.0f, 0.0f}, nullptr}};
   struct View {
     Camera camera;
     std::vector<double> runs;  // texel chords in units of l
@@ -123,8 +123,8 @@ TEST(AxialRender, VoxelizedGridRendersTheSameNebula) {
     RenderInputs in;
     in.density = &grid;
     for (size_t b = 0; b < 3; ++b)
-      in.bands.push_back(RenderBand{s.inputs.bands[b].name, s.inputs.bands[b].extinction_ratio, 0.6f, &s.table, &emission[b]});
-    in.stars.push_back(RenderStar{s.inputs.stars[0].position, s.inputs.stars[0].power, &depth});
+      in.bands.push_back(RenderBand{{s.inputs.bands[b].name, s.inputs.bands[b].extinction_ratio, 0.6f}, &s.table, &emission[b]});
+    in.stars.push_back(BakedStar{{s.inputs.stars[0].position, s.inputs.stars[0].power}, &depth});
     in.camera = s.inputs.camera;
     const Image voxels = render_cpu(in, nullptr);
     const double err = relative_l1(axial, voxels);

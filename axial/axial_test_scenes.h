@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "illumination/axial_bake.h"
-#include "raycast/axial_renderer.h"
+#include "axial/axial_bake.h"
+#include "axial/axial_renderer.h"
 #include "raycast/test_scenes.h"
 
 namespace nebula::testing {
@@ -26,11 +26,11 @@ struct AxialScene {
     map.axis = axis;
     table = thin_table(0.6, 72, 10.0);
     const float ratios[3] = {1.25f, 1.0f, 0.85f};
-    for (int b = 0; b < 3; ++b) inputs.bands.push_back(AxialRenderBand{std::string(1, "BVR"[b]), ratios[b], 0.6f, &table});
+    for (int b = 0; b < 3; ++b) inputs.bands.push_back(AxialRenderBand{{std::string(1, "BVR"[b]), ratios[b], 0.6f}, &table});
     if (star_power > 0) {
       const float xs = map.nx * map.texel / 3.0f;
       depth = bake_axial_star_depths(map.nx, map.nr, map.texel, map.tau_v, {xs}, Backend::Cpu).tau_v;
-      inputs.stars.push_back(AxialRenderStar{map.origin + xs * map.axis, {star_power, star_power, star_power}, &depth[0]});
+      inputs.stars.push_back(BakedStar{{map.origin + xs * map.axis, {star_power, star_power, star_power}}, &depth[0]});
     }
     inputs.map = &map;
     inputs.step_aside = false;  // run the skip code even on the full map

@@ -30,6 +30,14 @@ struct StarLight {
   std::vector<float> power;
 };
 
+// The bands' names in order: the planes of every image a renderer makes.
+template <class AnyBand>
+std::vector<std::string> band_names(const std::vector<AnyBand>& bands) {
+  std::vector<std::string> names;
+  for (const Band& b : bands) names.push_back(b.name);
+  return names;
+}
+
 // A star with its baked V-band optical depth to every cell of the volume a
 // renderer marches (voxels of a grid, texels of an axial map).
 struct BakedStar : StarLight {

@@ -1,6 +1,7 @@
-#include "raycast/camera.h"
+#include "core/camera.h"
 
 #include <cmath>
+#include <utility>
 
 #include "core/error.h"
 
@@ -14,30 +15,84 @@ const char* to_string(Projection p) {
   }
 }
 
+bool parse_projection(const std::string& name, Projection& out) {
+  for (Projection p : {Projection::Perspective, Projection::Orthographic, Projection::Fisheye})
+    if (name == to_string(p)) {
+      out = p;
+      return true;
+    }
+  return false;
+}
+
+namespace {
+
+bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+std::string vec_text(Vec3 v) { return "[" + to_text(v.x) + ", " + to_text(v.y) + ", " + to_text(v.z) + "]"; }
+
+}  // namespace
+
+std::optional<CameraIssue> camera_issue(const CameraSettings& c) {
+  if (!finite(c.position)) return CameraIssue{"position", "must be finite"};
+  if (!finite(c.look_at)) return CameraIssue{"look_at", "must be finite"};
+  if (!finite(c.up)) return CameraIssue{"up", "must be finite"};
+  // In double: a float cross product of large or nearly parallel vectors loses the answer.
+  const double dx = double(c.look_at.x) - c.position.x, dy = double(c.look_at.y) - c.position.y,
+               dz = double(c.look_at.z) - c.position.z;
+  const double view = std::sqrt(dx * dx + dy * dy + dz * dz);
+  const double scale = std::fmax(1.0, std::sqrt(double(dot(c.position, c.position))));
+  if (!(view > 1e-6 * scale))
+    return CameraIssue{"look_at", "equals the position " + vec_text(c.position) + ": the view direction has zero length"};
+  const double ux = c.up.x, uy = c.up.y, uz = c.up.z;
+  const double up = std::sqrt(ux * ux + uy * uy + uz * uz);
+  if (!(up > 0)) return CameraIssue{"up", "must not be the zero vector"};
+  // |d x u| / (|d| |u|) = sin of the angle between them.
+  const double cx = dy * uz - dz * uy, cy = dz * ux - dx * uz, cz = dx * uy - dy * ux;
+  const double sine = std::sqrt(cx * cx + cy * cy + cz * cz) / (view * up);
+  if (!(sine > 1e-6))
+    return CameraIssue{"up", "is " + vec_text(c.up) +
+                                 ", parallel to the view direction (look_at - position); choose an up vector across it"};
+  if (!(std::isfinite(c.fov_deg) && c.fov_deg > 0 && c.fov_deg < 180))
+    return CameraIssue{"fov_deg", "is " + to_text(c.fov_deg) + "; must be in (0, 180)"};
+  if (c.projection == Projection::Orthographic) {
+    if (!(std::isfinite(c.ortho_width) && c.ortho_width > 0))
+      return CameraIssue{"ortho_width", "is " + to_text(c.ortho_width) +
+                                            "; an orthographic camera needs a width (parsecs across the image) > 0"};
+  } else if (!(std::isfinite(c.ortho_width) && c.ortho_width >= 0)) {
+    return CameraIssue{"ortho_width", "is " + to_text(c.ortho_width) + "; must be >= 0"};
+  }
+  for (const auto& [field, size] : {std::pair<const char*, int>{"width", c.width}, {"height", c.height}}) {
+    if (size < 1) return CameraIssue{field, "is " + std::to_string(size) + "; must be >= 1"};
+    if (size > kMaxCameraPixels)
+      return CameraIssue{field, "is " + std::to_string(size) + "; must be <= " + std::to_string(kMaxCameraPixels)};
+  }
+  if (c.projection == Projection::Fisheye && c.width != c.height)
+    return CameraIssue{"height", "is " + std::to_string(c.height) + " but width is " + std::to_string(c.width) +
+                                     "; a fisheye dome master must be square"};
+  if (!(std::isfinite(c.exposure) && c.exposure > 0))
+    return CameraIssue{"exposure", "is " + to_text(c.exposure) + "; must be > 0"};
+  return std::nullopt;
+}
+
 Camera make_camera(const CameraSettings& s) {
-  if (s.width < 1 || s.height < 1) throw Error("camera: width and height must be positive");
-  const Vec3 view = s.look_at - s.position;
-  if (!(length(view) > 0)) throw Error("camera.look_at: must differ from camera.position");
+  if (auto issue = camera_issue(s)) throw ParameterError("camera." + issue->field, issue->reason);
   Camera c;
   c.projection = s.projection;
   c.position = s.position;
   c.width = c.frame_width = s.width;
   c.height = c.frame_height = s.height;
-  c.forward = normalize(view);
+  c.forward = normalize(s.look_at - s.position);
   const Vec3 side = cross(c.forward, s.up);
+  // camera_issue decides in double; a float cross product can still vanish.
   if (!(length(side) > 1e-6f * length(s.up)))
-    throw Error("camera.up: must not be parallel to the view direction");
+    throw ParameterError("camera.up", "is " + vec_text(s.up) + ", too close to the view direction");
   c.right = normalize(side);
   c.up = cross(c.right, c.forward);
   if (s.projection == Projection::Perspective) {
-    if (!(s.fov_deg > 0 && s.fov_deg < 180)) throw Error("camera.fov_deg: must be in (0, 180)");
     c.tan_half_fov = static_cast<float>(std::tan(s.fov_deg * kPiD / 360.0));
   } else if (s.projection == Projection::Orthographic) {
-    if (!(s.ortho_width > 0)) throw Error("camera.ortho_width: must be positive for an orthographic camera");
     c.half_width = static_cast<float>(0.5 * s.ortho_width);
     c.half_height = c.half_width * s.height / s.width;
-  } else if (s.width != s.height) {
-    throw Error("camera: a fisheye dome master must be square (width == height)");
   }
   return c;
 }

@@ -1,7 +1,10 @@
 #pragma once
-// Cameras: perspective, orthographic (the telescope view of a distant
-// observer) and the 180-degree fulldome fisheye (azimuthal equidistant dome
-// master). Pixel (0, 0) is the top-left corner of the image.
+// The one camera model: perspective, orthographic (the telescope view of a
+// distant observer) and the 180-degree fulldome fisheye (azimuthal equidistant
+// dome master). CameraSettings is what a scene file or a program sets;
+// make_camera turns it into the Camera every renderer traces rays with.
+// Pixel (0, 0) is the top-left corner of the image.
+#include <optional>
 #include <string>
 
 #include "core/hd.h"
@@ -61,18 +64,33 @@ struct Camera {
 struct CameraSettings {
   Projection projection = Projection::Perspective;
   Vec3 position{0, 0, -10}, look_at{0, 0, 0}, up{0, 1, 0};
-  double fov_deg = 40;      // perspective, vertical
-  double ortho_width = 0;   // orthographic: world units across the image
-  int width = 512, height = 512;
+  double fov_deg = 40;      // perspective: full vertical field of view, (0, 180)
+  double ortho_width = 0;   // orthographic: world units across the image width, > 0
+  int width = 512, height = 512;  // pixels, 1 to kMaxCameraPixels; a fisheye needs width == height
+  double exposure = 1.0;    // multiplies the rendered radiance, > 0
 };
 
-// Builds the camera; throws Error naming the setting when it is degenerate.
+constexpr int kMaxCameraPixels = 1 << 16;  // per side
+
+// The first setting that makes no camera: its field name as CameraSettings
+// spells it (and a scene file's [camera] table does; "kind" for the
+// projection) and the reason, or nothing.
+struct CameraIssue {
+  std::string field, reason;
+};
+std::optional<CameraIssue> camera_issue(const CameraSettings& s);
+
+// Builds the camera; throws ParameterError("camera.<field>", reason) for the
+// first camera_issue.
 Camera make_camera(const CameraSettings& s);
 
 // The same frame at half the resolution (ceil of each size): pixel i covers
 // pixels 2i and 2i + 1 of `c` (the pyramid's image levels).
 Camera coarser_camera(const Camera& c);
 
+// "perspective", "orthographic", "fisheye" (the scene file's camera.kind).
 const char* to_string(Projection p);
+// The projection a name gives; false for any other name.
+bool parse_projection(const std::string& name, Projection& out);
 
 }  // namespace nebula

@@ -1,4 +1,4 @@
-#include "raycast/camera.h"
+#include "core/camera.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 #pragma once
-// A device array that frees itself; CUDA errors become nebula::Error. For
-// .cu files only (needs the CUDA runtime).
+// The one owner of device memory: an array that frees itself; CUDA errors
+// become nebula::Error. For .cu files only (needs the CUDA runtime).
 #include <cuda_runtime.h>
 
 #include <algorithm>

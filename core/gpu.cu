@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "core/error.h"
 #include "core/gpu.h"
 
 namespace nebula {
@@ -30,5 +31,9 @@ std::string gpu_description() {
   return std::string(prop.name) + " (" + std::to_string(prop.multiProcessorCount) + " SMs, sm_" +
          std::to_string(prop.major) + std::to_string(prop.minor) + ")";
 }
+
+// Unused in a CUDA build (no *_none.cpp entry point is compiled), kept so the
+// declaration has one meaning in every build.
+void no_cuda_backend() { throw ParameterError("backend", "cuda: not available"); }
 
 }  // namespace nebula

@@ -10,4 +10,8 @@ bool gpu_available(std::string* reason = nullptr);
 // One line naming the device, e.g. "NVIDIA H100 80GB HBM3 (132 SMs, sm_90)".
 std::string gpu_description();
 
+// What every CUDA entry point of a build without CUDA does: throws
+// ParameterError("backend", ...) saying so.
+[[noreturn]] void no_cuda_backend();
+
 }  // namespace nebula

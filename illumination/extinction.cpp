@@ -80,11 +80,12 @@ double band_extinction_ratio(const Passband& passband, double R_V, ExtinctionLaw
   return extinction / weight;
 }
 
-BandRatios extinction_ratios(double R_V, ExtinctionLaw law, const Passband& B, const Passband& V,
-                             const Passband& R, const std::function<double(double)>* spectrum) {
+std::vector<double> extinction_ratios(const std::vector<Passband>& filters, const Passband& V, double R_V,
+                                      ExtinctionLaw law, const std::function<double(double)>* spectrum) {
   const double v = band_extinction_ratio(V, R_V, law, spectrum);
-  return {band_extinction_ratio(B, R_V, law, spectrum) / v, 1.0,
-          band_extinction_ratio(R, R_V, law, spectrum) / v};
+  std::vector<double> out;
+  for (const Passband& f : filters) out.push_back(band_extinction_ratio(f, R_V, law, spectrum) / v);
+  return out;
 }
 
 }  // namespace nebula

@@ -1,5 +1,6 @@
 #pragma once
 #include <functional>
+#include <vector>
 
 #include "illumination/passband.h"
 
@@ -41,15 +42,10 @@ double extinction_ratio_at(double wavelength_nm, double R_V, ExtinctionLaw law);
 double band_extinction_ratio(const Passband& passband, double R_V, ExtinctionLaw law,
                              const std::function<double(double)>* spectrum = nullptr);
 
-struct BandRatios {
-  double B, V, R;
-};
-
-// A_b/A_V per band for tau_b = tau_v * (A_b/A_V) (DESIGN.md section 3): each
-// band average divided by the V band's, so V is exactly 1 and tau_v is the
-// extinction depth in the V passband.
-BandRatios extinction_ratios(double R_V, ExtinctionLaw law, const Passband& B, const Passband& V,
-                             const Passband& R,
-                             const std::function<double(double)>* spectrum = nullptr);
+// A_b/A_V for each of `filters` (tau_b = tau_v * (A_b/A_V), DESIGN.md section
+// 3): each band average divided by the V filter's, so the V filter gives
+// exactly 1 and tau_v is the extinction depth in the V passband.
+std::vector<double> extinction_ratios(const std::vector<Passband>& filters, const Passband& V, double R_V,
+                                      ExtinctionLaw law, const std::function<double(double)>* spectrum = nullptr);
 
 }  // namespace nebula

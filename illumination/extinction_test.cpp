@@ -1,4 +1,5 @@
 #include "illumination/extinction.h"
+#include "illumination/filters.h"
 
 #include <gtest/gtest.h>
 
@@ -153,15 +154,24 @@ TEST(Extinction, RefusesWavelengthsOutsideTheLawAndBadRV) {
     } catch (const Error& e) {
       EXPECT_NE(std::string(e.what()).find("R_V"), std::string::npos) << e.what();
     }
-    EXPECT_THROW(band_extinction_ratio(bessell('V'), R_V, ExtinctionLaw::CCM89), Error);
+    EXPECT_THROW(band_extinction_ratio(load_filter("V"), R_V, ExtinctionLaw::CCM89), Error);
   }
   // The U band reaches below 303 nm (x = 3.3), into the ultraviolet.
-  EXPECT_THROW(band_extinction_ratio(bessell('U'), 3.1, ExtinctionLaw::CCM89), Error);
+  EXPECT_THROW(band_extinction_ratio(load_filter("U"), 3.1, ExtinctionLaw::CCM89), Error);
+}
+
+// The three Johnson bands of extinction_ratios, by name.
+struct BandRatios {
+  double B, V, R;
+};
+BandRatios extinction_ratios(double R_V, ExtinctionLaw law, const Passband& B, const Passband& V, const Passband& R) {
+  const std::vector<double> r = extinction_ratios({B, V, R}, V, R_V, law);
+  return {r[0], r[1], r[2]};
 }
 
 class BandRatiosTest : public ::testing::Test {
  protected:
-  Passband B = bessell('B'), V = bessell('V'), R = bessell('R');
+  Passband B = load_filter("B"), V = load_filter("V"), R = load_filter("R");
 };
 
 TEST_F(BandRatiosTest, VIsExactlyOneAndBandsAreOrdered) {

@@ -4,6 +4,7 @@
 
 #include "core/cuda_check.h"
 #include "core/cuda_timer.h"
+#include "core/device_array.h"
 #include "illumination/optical_depth_bake.h"
 
 namespace nebula {
@@ -22,32 +23,21 @@ __global__ void bake_kernel(DensityView grid, Vec3 star, float* depth) {
 
 BakeResult bake_star_depths_cuda(const DensityGrid& grid, const std::vector<Vec3>& stars) {
   const GridShape& g = grid.shape;
-  const size_t bytes = g.count() * sizeof(float);
-  float *d_tau = nullptr, *d_depth = nullptr;
-  NEBULA_CUDA_CHECK(cudaMalloc(&d_tau, bytes));
-  NEBULA_CUDA_CHECK(cudaMalloc(&d_depth, bytes * stars.size()));
+  const DeviceArray<float> tau(grid.tau_v);
+  DeviceArray<float> depth(g.count() * stars.size());
+  const DensityView view{g, tau.get()};
+  const dim3 block(32, 8), blocks((g.nx + 31) / 32, (g.ny + 7) / 8, g.nz);
   BakeResult out;
-  try {
-    NEBULA_CUDA_CHECK(cudaMemcpy(d_tau, grid.tau_v.data(), bytes, cudaMemcpyHostToDevice));
-    const DensityView view{g, d_tau};
-    const dim3 block(32, 8), blocks((g.nx + 31) / 32, (g.ny + 7) / 8, g.nz);
-    CudaEventTimer timer;
-    for (size_t s = 0; s < stars.size(); ++s) {
-      bake_kernel<<<blocks, block>>>(view, stars[s], d_depth + s * g.count());
-      NEBULA_CUDA_CHECK(cudaGetLastError());
-    }
-    out.seconds = timer.seconds();
-    out.tau_v.assign(stars.size(), std::vector<float>(g.count()));
-    for (size_t s = 0; s < stars.size(); ++s)
-      NEBULA_CUDA_CHECK(cudaMemcpy(out.tau_v[s].data(), d_depth + s * g.count(), bytes,
-                                   cudaMemcpyDeviceToHost));
-  } catch (...) {
-    cudaFree(d_tau);
-    cudaFree(d_depth);
-    throw;
+  CudaEventTimer timer;
+  for (size_t s = 0; s < stars.size(); ++s) {
+    bake_kernel<<<blocks, block>>>(view, stars[s], depth.get() + s * g.count());
+    NEBULA_CUDA_CHECK(cudaGetLastError());
   }
-  cudaFree(d_tau);
-  cudaFree(d_depth);
+  out.seconds = timer.seconds();
+  out.tau_v.assign(stars.size(), std::vector<float>(g.count()));
+  for (size_t s = 0; s < stars.size(); ++s)
+    NEBULA_CUDA_CHECK(cudaMemcpy(out.tau_v[s].data(), depth.get() + s * g.count(), g.count() * sizeof(float),
+                                 cudaMemcpyDeviceToHost));
   return out;
 }
 

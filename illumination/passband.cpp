@@ -93,14 +93,6 @@ Passband load_passband(const std::string& path) {
   return band;
 }
 
-Passband load_bessell(const std::string& data_dir, char band) {
-  if (std::string_view("UBVRI").find(band) == std::string_view::npos)
-    throw Error(std::string("unknown Bessell band '") + band + "': expected one of U, B, V, R, I");
-  return load_passband(data_dir + "/filters/bessell-" + band + ".csv");
-}
-
-Passband bessell(char band) { return load_bessell(default_data_dir(), band); }
-
 double passband_integral(const Passband& passband, const std::function<double(double)>& f,
                          int subdivisions) {
   if (subdivisions < 1)

@@ -21,11 +21,6 @@ struct Passband {
 // fewer than 2 rows; the Error names the file and line.
 Passband load_passband(const std::string& path);
 
-// Bessell (1990) U, B, V, R or I from <data_dir>/filters/bessell-<band>.csv;
-// bessell(band) reads it from default_data_dir().
-Passband load_bessell(const std::string& data_dir, char band);
-Passband bessell(char band);
-
 // The integral of T(lambda) f(lambda) d lambda over the passband (lambda in
 // nm, so the result carries a factor nm). Each tabulated interval is cut into
 // `subdivisions` equal steps with T linear on it, and the product is

@@ -1,4 +1,5 @@
 #include "illumination/passband.h"
+#include "illumination/filters.h"
 
 #include <gtest/gtest.h>
 
@@ -53,7 +54,7 @@ class PassbandFile : public ::testing::Test {
 };
 
 TEST(Passband, BessellFilesLoadInNanometres) {
-  const Passband v = bessell('V');
+  const Passband v = load_filter("V");
   EXPECT_EQ(v.name, "bessell-V");
   ASSERT_EQ(v.wavelength_nm.size(), 24u);
   ASSERT_EQ(v.response.size(), 24u);
@@ -62,7 +63,7 @@ TEST(Passband, BessellFilesLoadInNanometres) {
   EXPECT_EQ(v.response.front(), 0.0);
   EXPECT_EQ(v.response[6], 1.0);  // the peak, 530 nm
   for (char band : std::string("UBVRI")) {
-    const Passband p = load_bessell(default_data_dir(), band);
+    const Passband p = load_filter(std::string(1, band));
     double peak = 0.0;
     for (double r : p.response) peak = std::max(peak, r);
     EXPECT_EQ(peak, 1.0) << band;  // the tables are normalised to a peak of 1
@@ -80,7 +81,7 @@ TEST(Passband, MeanWavelengthsMatchBessell) {
     double published_angstrom;
   } cases[] = {{'U', 3605}, {'B', 4413}, {'V', 5512}, {'R', 6586}, {'I', 8060}};
   for (const auto& c : cases) {
-    const double mean_angstrom = 10.0 * mean_wavelength_nm(bessell(c.band));
+    const double mean_angstrom = 10.0 * mean_wavelength_nm(load_filter(std::string(1, c.band)));
     std::printf("  %c: mean wavelength %.2f A (published %.0f A)\n", c.band, mean_angstrom,
                 c.published_angstrom);
     EXPECT_NEAR(mean_angstrom, c.published_angstrom, 0.005 * c.published_angstrom) << c.band;
@@ -167,9 +168,9 @@ TEST(Passband, RefusesMissingFileAndUnknownBand) {
               std::string::npos)
         << e.what();
   }
-  EXPECT_THROW(bessell('Q'), Error);
-  EXPECT_THROW(bessell('v'), Error);  // lower case r, i would suggest SDSS bands
-  EXPECT_THROW(load_bessell("/nonexistent", 'V'), Error);
+  EXPECT_THROW(load_filter("Q"), Error);
+  EXPECT_THROW(load_filter("v"), Error);  // lower case r, i would suggest SDSS bands
+  EXPECT_THROW(load_filter("V", "/nonexistent"), Error);
 }
 
 TEST(DataDir, CompiledInFolderHoldsTheFiltersAndEnvironmentOverridesIt) {

@@ -88,10 +88,10 @@ double band_fraction(double temperature_K, const Passband& passband) {
   return in_band * 1e-9 / total;
 }
 
-BandFluxes star_band_fractions(double temperature_K, const Passband& B, const Passband& V,
-                               const Passband& R) {
-  return {band_fraction(temperature_K, B), band_fraction(temperature_K, V),
-          band_fraction(temperature_K, R)};
+std::vector<double> band_fractions(double temperature_K, const std::vector<Passband>& filters) {
+  std::vector<double> out;
+  for (const Passband& f : filters) out.push_back(band_fraction(temperature_K, f));
+  return out;
 }
 
 }  // namespace nebula

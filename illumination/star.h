@@ -36,11 +36,7 @@ double planck_total_radiance(double temperature_K);
 // L emits Phi_b = L * fraction in band b.
 double band_fraction(double temperature_K, const Passband& passband);
 
-struct BandFluxes {
-  double B, V, R;
-};
-
-BandFluxes star_band_fractions(double temperature_K, const Passband& B, const Passband& V,
-                               const Passband& R);
+// band_fraction for each of `filters`, in their order.
+std::vector<double> band_fractions(double temperature_K, const std::vector<Passband>& filters);
 
 }  // namespace nebula

@@ -1,4 +1,5 @@
 #include "illumination/star.h"
+#include "illumination/filters.h"
 
 #include <gtest/gtest.h>
 
@@ -41,8 +42,17 @@ TEST(Star, RefusesUnknownClasses) {
   }
 }
 
+// The three Johnson bands of band_fractions, by name.
+struct BandFluxes {
+  double B, V, R;
+};
+BandFluxes star_band_fractions(double T, const Passband& B, const Passband& V, const Passband& R) {
+  const std::vector<double> f = band_fractions(T, {B, V, R});
+  return {f[0], f[1], f[2]};
+}
+
 TEST(Star, RefusesNonPositiveTemperature) {
-  const Passband V = bessell('V');
+  const Passband V = load_filter("V");
   for (double T : {0.0, -5770.0, double(NAN), double(INFINITY)}) {
     EXPECT_THROW(planck_radiance(550e-9, T), Error) << T;
     EXPECT_THROW(planck_total_radiance(T), Error) << T;
@@ -109,7 +119,7 @@ TEST(Star, PlanckIntegratesToStefanBoltzmann) {
 
 class BandFractionsTest : public ::testing::Test {
  protected:
-  Passband B = bessell('B'), V = bessell('V'), R = bessell('R');
+  Passband B = load_filter("B"), V = load_filter("V"), R = load_filter("R");
 };
 
 TEST_F(BandFractionsTest, ArePartsOfTheWhole) {

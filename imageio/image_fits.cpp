@@ -3,7 +3,7 @@
 // is the lower left corner as FITS viewers show it), so row y of an Image is
 // FITS row NAXIS2 - y on both write and read. Keywords: BUNIT, BAND1..n,
 // EXPOSURE, one keyword per metadata entry, CHECKSUM and DATASUM
-// (imageio/README.md).
+// (docs/image_files.md).
 #include <fitsio.h>
 
 #include <algorithm>

@@ -1,7 +1,7 @@
 // The HDF5 image file: /image float32 [bands][height][width], row 0 at the
 // top, one checksummed chunk per band, with the band names, units, exposure,
 // schema version and metadata entries as attributes of the root group
-// (imageio/README.md).
+// (docs/image_files.md).
 #include <hdf5.h>
 
 #include <algorithm>

@@ -201,8 +201,7 @@ void check_metadata(const ImageMetadata& m, const std::string& path) {
 
 }  // namespace
 
-void write_image(const Image& image, const std::string& path, const ImageMetadata& metadata,
-                 bool overwrite) {
+void check_image_format(const std::string& path) {
   Format format{};
   if (!format_of(path, format))
     throw Error("cannot write " + path + ": unknown image extension " + extension_of(path) +
@@ -211,6 +210,13 @@ void write_image(const Image& image, const std::string& path, const ImageMetadat
     throw Error("cannot write " + path + ": " + (format == Format::Exr ? ".exr" : ".png") +
                 " output needs OpenImageIO; this build has none (configure with "
                 "-DNEBULA_OPENIMAGEIO=ON), use .h5 or .fits");
+}
+
+void write_image(const Image& image, const std::string& path, const ImageMetadata& metadata,
+                 bool overwrite) {
+  check_image_format(path);
+  Format format{};
+  format_of(path, format);
   check_image(image, path, format);
   check_metadata(metadata, path);
   check_output_target(path, overwrite, "folder", true);
@@ -282,6 +288,13 @@ Image read_image(const std::string& path, ImageMetadata* metadata) {
                    ", y " + std::to_string(y) + ")");
   if (metadata != nullptr) *metadata = read_metadata;
   return image;
+}
+
+std::string variance_path(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  const size_t dot = path.rfind('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return path + ".var";
+  return path.substr(0, dot) + ".var" + path.substr(dot);
 }
 
 }  // namespace nebula

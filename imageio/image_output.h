@@ -1,7 +1,7 @@
 #pragma once
 // Rendered images to and from files (DESIGN.md section 4): linear float per
 // band to HDF5, FITS and EXR, tone-mapped sRGB to PNG. Layouts, orientation
-// and the tone curve are in imageio/README.md.
+// and the tone curve are in docs/image_files.md.
 #include <string>
 #include <utility>
 #include <vector>
@@ -33,6 +33,10 @@ struct ImageMetadata {
 void write_image(const Image& image, const std::string& path, const ImageMetadata& metadata,
                  bool overwrite);
 
+// write_image's first check, for callers that refuse a path before any work:
+// an unknown extension, or .exr/.png in a build without OpenImageIO.
+void check_image_format(const std::string& path);
+
 // Reads an image written by write_image (.h5, .fits/.fit, and .exr with
 // OpenImageIO), filling *metadata when given (gamma is not stored and stays
 // at its default). Refuses missing, foreign, truncated or malformed files and
@@ -40,12 +44,16 @@ void write_image(const Image& image, const std::string& path, const ImageMetadat
 Image read_image(const std::string& path, ImageMetadata* metadata = nullptr);
 
 // Reads any image OpenImageIO can open (PNG, TIFF, JPEG, EXR, ...) as float
-// planes, for data such as axial maps (raycast/AXIAL.md): channels named as
+// planes, for data such as axial maps (docs/axial.md): channels named as
 // the file names them (R, G, B, A; Y for a single grey channel), integer
 // formats scaled to [0, 1] by OpenImageIO, row 0 at the top. Refuses, with
 // one line naming the file: a build without OpenImageIO, an unreadable or
 // deep or 3-D image, non-finite values.
 Image read_any_image(const std::string& path);
+
+// Where the variance of an image lives (the ground truth writes one beside its
+// image; comparisons look for it): "out.h5" -> "out.var.h5".
+std::string variance_path(const std::string& image_path);
 
 // Whether this build has OpenImageIO, and so .exr and .png.
 bool openimageio_available();

@@ -857,5 +857,10 @@ TEST_F(ImageFile, ForeignFitsKeywordsAreNotEntries) {
   expect_same_metadata(m, back);
 }
 
+TEST(ImagePaths, VarianceLivesBesideTheImage) {
+  EXPECT_EQ(variance_path("out/truth.h5"), "out/truth.var.h5");
+  EXPECT_EQ(variance_path("a.b/truth"), "a.b/truth.var");
+}
+
 }  // namespace
 }  // namespace nebula

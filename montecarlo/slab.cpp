@@ -10,20 +10,17 @@
 #include "montecarlo/tabulate.h"
 
 namespace nebula {
-namespace {
-
-}  // namespace
 
 void validate(const SlabParams& p) {
   if (!(p.albedo >= 0.0 && p.albedo <= 1.0))
-    throw Error("--albedo: must be in [0, 1], got " + to_text(p.albedo));
-  if (!(std::fabs(p.g) < 1.0)) throw Error("--g: |g| must be below 1, got " + to_text(p.g));
+    throw ParameterError("albedo", "must be in [0, 1], got " + to_text(p.albedo));
+  if (!(std::fabs(p.g) < 1.0)) throw ParameterError("g", "|g| must be below 1, got " + to_text(p.g));
   if (!(p.tau > 0.0) || std::isnan(p.tau))
-    throw Error("--tau: must be a positive optical thickness, got " + to_text(p.tau));
+    throw ParameterError("tau", "must be a positive optical thickness, got " + to_text(p.tau));
   if (!(p.incidence_deg >= 0.0 && p.incidence_deg < 90.0))
-    throw Error("--incidence-deg: must be in [0, 90), got " + to_text(p.incidence_deg));
+    throw ParameterError("incidence_deg", "must be in [0, 90), got " + to_text(p.incidence_deg));
   if (p.photons < 2 || p.photons > kMaxPhotonsPerRow)
-    throw Error("--photons: need 2 to 2^30 photons, got " + to_text(double(p.photons)));
+    throw ParameterError("photons", "need 2 to 2^30 photons, got " + to_text(double(p.photons)));
 }
 
 SlabRun make_slab_run(const SlabParams& p) {

@@ -58,6 +58,7 @@ struct SlabResult {
   std::string device;
 };
 
+// Throws ParameterError naming the field of the first bad parameter.
 void validate(const SlabParams& p);
 SlabRun make_slab_run(const SlabParams& p);
 SlabResult simulate_slab(const SlabParams& p, Backend backend, Progress* progress = nullptr);

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "core/error.h"
 #include "core/math.h"
 #include "montecarlo/test_stats.h"
 

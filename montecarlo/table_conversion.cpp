@@ -1,4 +1,4 @@
-#include "validation/table_conversion.h"
+#include "montecarlo/table_conversion.h"
 
 namespace nebula {
 

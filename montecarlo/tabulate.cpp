@@ -9,28 +9,25 @@
 #include "core/math.h"
 
 namespace nebula {
-namespace {
-
-}  // namespace
 
 void validate(const TabulateParams& p) {
   if (!(p.albedo >= 0.0 && p.albedo <= 1.0))
-    throw Error("--albedo: must be in [0, 1], got " + to_text(p.albedo));
+    throw ParameterError("albedo", "must be in [0, 1], got " + to_text(p.albedo));
   if (!(std::fabs(p.g) < 1.0))
-    throw Error("--g: |g| must be below 1 (g = +-1 is a delta function), got " + to_text(p.g));
+    throw ParameterError("g", "|g| must be below 1 (g = +-1 is a delta function), got " + to_text(p.g));
   if (!(p.tau_max > 0.0) || !std::isfinite(p.tau_max))
-    throw Error("--tau-max: must be a positive finite optical depth, got " + to_text(p.tau_max));
-  if (p.tau_bins < 2) throw Error("--tau-bins: need at least 2 rows, got " + to_text(p.tau_bins));
+    throw ParameterError("tau_max", "must be a positive finite optical depth, got " + to_text(p.tau_max));
+  if (p.tau_bins < 2) throw ParameterError("tau_bins", "need at least 2 rows, got " + to_text(p.tau_bins));
   if (p.mu_bins < 2 || p.mu_bins > kMaxMuBins)
-    throw Error("--mu-bins: need 2 to " + to_text(kMaxMuBins) + " bins, got " + to_text(p.mu_bins));
+    throw ParameterError("mu_bins", "need 2 to " + to_text(kMaxMuBins) + " bins, got " + to_text(p.mu_bins));
   if (p.photons_per_row < 2 || p.photons_per_row > kMaxPhotonsPerRow)
-    throw Error("--photons: need 2 to 2^30 photons per row, got " + to_text(double(p.photons_per_row)));
+    throw ParameterError("photons_per_row", "need 2 to 2^30 photons per row, got " + to_text(double(p.photons_per_row)));
   if (!(p.roulette.threshold > 0 && p.roulette.threshold < 1) ||
       !(p.roulette.survival > 0 && p.roulette.survival <= 1) || p.roulette.max_orders < 1)
-    throw Error("roulette: threshold in (0, 1), survival in (0, 1] and max orders >= 1 required");
+    throw ParameterError("roulette", "threshold in (0, 1), survival in (0, 1] and max orders >= 1 required");
   // Survivors' weight threshold / survival must stay below 1 for the fixed-point tallies.
   if (p.roulette.threshold / p.roulette.survival > 1.0f)
-    throw Error("roulette: threshold / survival must not exceed 1");
+    throw ParameterError("roulette", "threshold / survival must not exceed 1");
 }
 
 double tau_of_row(const TabulateParams& p, int row) {

@@ -32,7 +32,7 @@ struct TabulateParams {
 constexpr uint64_t kMaxPhotonsPerRow = uint64_t(1) << 30;
 constexpr int kMaxMuBins = 8192;
 
-// Throws Error naming the command-line option of the first bad parameter.
+// Throws ParameterError naming the field of the first bad parameter.
 void validate(const TabulateParams& p);
 
 double tau_of_row(const TabulateParams& p, int row);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/cuda_check.h"
+#include "core/device_array.h"
 #include "core/cuda_timer.h"
 #include "core/progress.h"
 #include "montecarlo/slab.h"
@@ -107,35 +108,15 @@ __global__ void __launch_bounds__(kThreads) slab_kernel(SlabRun run, uint32_t be
   for (int k = 0; k < 8; ++k) warp_add_to(&out[k], v[k]);
 }
 
-template <class T>
-struct DeviceBuffer {
-  T* ptr = nullptr;
-  size_t count = 0;
-  explicit DeviceBuffer(size_t n) : count(n) {
-    NEBULA_CUDA_CHECK(cudaMalloc(&ptr, n * sizeof(T)));
-    NEBULA_CUDA_CHECK(cudaMemset(ptr, 0, n * sizeof(T)));
-  }
-  ~DeviceBuffer() { cudaFree(ptr); }
-  DeviceBuffer(const DeviceBuffer&) = delete;
-  DeviceBuffer& operator=(const DeviceBuffer&) = delete;
-  std::vector<T> download() const {
-    std::vector<T> host(count);
-    NEBULA_CUDA_CHECK(cudaMemcpy(host.data(), ptr, count * sizeof(T), cudaMemcpyDeviceToHost));
-    return host;
-  }
-};
-
 }  // namespace
 
 SphereTallies tabulate_sphere_cuda(const TabulateParams& p, Progress* progress) {
   const int n_tau = p.tau_bins, n_mu = p.mu_bins;
   std::vector<SphereRow> host_rows(n_tau);
   for (int i = 0; i < n_tau; ++i) host_rows[i] = make_sphere_row(p, i);
-  DeviceBuffer<SphereRow> rows(n_tau);
-  NEBULA_CUDA_CHECK(
-      cudaMemcpy(rows.ptr, host_rows.data(), n_tau * sizeof(SphereRow), cudaMemcpyHostToDevice));
-  DeviceBuffer<ull> sum_w(size_t(n_tau) * n_mu), sum_w2(size_t(n_tau) * n_mu);
-  DeviceBuffer<ull> scalars(size_t(4) * n_tau);
+  const DeviceArray<SphereRow> rows(host_rows);
+  DeviceArray<ull> sum_w(size_t(n_tau) * n_mu), sum_w2(size_t(n_tau) * n_mu);
+  DeviceArray<ull> scalars(size_t(4) * n_tau);
 
   const size_t shared = 2 * n_mu * sizeof(ull);
   NEBULA_CUDA_CHECK(cudaFuncSetAttribute(sphere_kernel, cudaFuncAttributeMaxDynamicSharedMemorySize,
@@ -148,8 +129,8 @@ SphereTallies tabulate_sphere_cuda(const TabulateParams& p, Progress* progress) 
   CudaEventTimer timer;
   for (int row_end = n_tau; row_end > 0; row_end -= rows_per_launch) {
     const int count = std::min(rows_per_launch, row_end);
-    sphere_kernel<<<dim3(chunks, count), kThreads, shared>>>(rows.ptr, row_end, photons, n_mu,
-                                                              sum_w.ptr, sum_w2.ptr, scalars.ptr);
+    sphere_kernel<<<dim3(chunks, count), kThreads, shared>>>(rows.get(), row_end, photons, n_mu,
+                                                              sum_w.get(), sum_w2.get(), scalars.get());
     NEBULA_CUDA_CHECK(cudaGetLastError());
     if (progress) {
       NEBULA_CUDA_CHECK(cudaDeviceSynchronize());
@@ -161,7 +142,10 @@ SphereTallies tabulate_sphere_cuda(const TabulateParams& p, Progress* progress) 
   SphereTallies t;
   t.resize(n_tau, n_mu);
   t.compute_seconds = transport_seconds;
-  const std::vector<ull> w = sum_w.download(), w2 = sum_w2.download(), s = scalars.download();
+  std::vector<ull> w(sum_w.size()), w2(sum_w2.size()), s(scalars.size());
+  sum_w.download(w.data());
+  sum_w2.download(w2.data());
+  scalars.download(s.data());
   std::copy(w.begin(), w.end(), t.sum_w.begin());
   std::copy(w2.begin(), w2.end(), t.sum_w2.begin());
   for (int i = 0; i < n_tau; ++i) {
@@ -175,7 +159,7 @@ SphereTallies tabulate_sphere_cuda(const TabulateParams& p, Progress* progress) 
 
 SlabTallies simulate_slab_cuda(const SlabParams& p, Progress* progress) {
   const SlabRun run = make_slab_run(p);
-  DeviceBuffer<ull> out(8);
+  DeviceArray<ull> out(8);
   const auto photons = static_cast<uint32_t>(p.photons);
   int sms = 0;
   NEBULA_CUDA_CHECK(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, 0));
@@ -183,12 +167,13 @@ SlabTallies simulate_slab_cuda(const SlabParams& p, Progress* progress) {
   for (uint32_t begin = 0; begin < photons; begin += slice) {
     const uint32_t end = std::min(photons, begin + slice);
     const uint32_t blocks = std::min<uint32_t>(sms * 8, (end - begin + kThreads - 1) / kThreads);
-    slab_kernel<<<blocks, kThreads>>>(run, begin, end, out.ptr);
+    slab_kernel<<<blocks, kThreads>>>(run, begin, end, out.get());
     NEBULA_CUDA_CHECK(cudaGetLastError());
     NEBULA_CUDA_CHECK(cudaDeviceSynchronize());
     if (progress) progress->add(end - begin);
   }
-  const std::vector<ull> v = out.download();
+  std::vector<ull> v(out.size());
+  out.download(v.data());
   SlabTallies t;
   t.sum_r = v[0];
   t.sum_r2 = v[1];

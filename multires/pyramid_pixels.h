@@ -1,6 +1,6 @@
 #pragma once
 // Per-pixel steps of the image pyramid, written once for the host loops
-// (image_pyramid.cpp) and the CUDA kernels (raycast/renderer_cuda.cu). A plane
+// (image_pyramid.cpp) and the CUDA kernels (pyramid_render_cuda.cu). A plane
 // is one band of an image, row-major, y = 0 the top row.
 #include "core/hd.h"
 

@@ -1,4 +1,4 @@
-#include "raycast/pyramid_render.h"
+#include "multires/pyramid_render.h"
 
 #include <chrono>
 
@@ -21,7 +21,7 @@ PreparedPyramid prepare_pyramid(const RenderInputs& in, int levels, Backend back
   // build_volume_pyramid's range check (and message), before any coarse work.
   if (levels < 0 || levels > max_pyramid_levels(in.density->shape)) build_volume_pyramid(*in.density, levels);
   std::vector<Vec3> positions;
-  for (const RenderStar& s : in.stars) positions.push_back(s.position);
+  for (const BakedStar& s : in.stars) positions.push_back(s.position);
   PreparedPyramid out;
   out.levels.reserve(levels);
   for (int j = 1; j <= levels; ++j) {

@@ -1,8 +1,10 @@
 #pragma once
 // Wide-range multiple scattering with the resolution pyramid of the 2005
-// paper (section 4.2; DESIGN.md section 3): volume level j (multires/) lit by
-// its own bake and rendered at 1/2^j of the resolution; the clipped
-// difference images are up-sampled and added to the level-0 image.
+// paper (section 4.2; DESIGN.md section 3): volume level j (volume_pyramid.h)
+// lit by its own bake and rendered by the ray marcher (raycast/) at 1/2^j of
+// the resolution; the clipped difference images (image_pyramid.h) are
+// up-sampled and added to the level-0 image, on the host or, with every level
+// image kept on the device, on the GPU (pyramid_render_cuda.cu).
 #include <cstdint>
 #include <vector>
 

@@ -1,10 +1,12 @@
-#include "raycast/pyramid_render.h"
+#include "multires/pyramid_render.h"
 
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <string>
 
 #include "core/error.h"
+#include "montecarlo/table_conversion.h"
 #include "montecarlo/tabulate.h"
 #include "raycast/test_scenes.h"
 
@@ -20,10 +22,7 @@ const ScatteringTable& mc_table() {
     p.mu_bins = 36;
     p.binning = AngularBinning::UniformTheta;
     p.photons_per_row = 20000;
-    const Tabulation t = tabulate(p, Backend::Cpu);
-    ScatteringTable out = ScatteringTable::make_axes(p.tau_max, p.tau_bins, p.binning, p.mu_bins);
-    for (size_t e = 0; e < t.P.size(); ++e) out.P[e] = static_cast<float>(t.P[e]);
-    return out;
+    return to_table(tabulate(p, Backend::Cpu));
   }();
   return table;
 }
@@ -48,9 +47,15 @@ struct LayerScene {
     depth = bake_star_depths_cpu(grid, {star}).tau_v[0];
     in.density = &grid;
     const float ratio[3] = {1.25f, 1.0f, 0.85f};
-    const char* names[3] = {"B", "V", "R"};
-    for (int b = 0; b < 3; ++b) in.bands.push_back(RenderBand{names[b], ratio[b], 0.6f, &mc_table(), nullptr});
-    in.stars = {RenderStar{star, {1.0f, 1.0f, 1.0f}, &depth}};
+    const std::string names[3] = {"B", "V", "R"};
+    for (int b = 0; b < 3; ++b) {
+      RenderBand band;
+      band.name = names[b];
+      band.extinction_ratio = ratio[b];
+      band.table = &mc_table();
+      in.bands.push_back(band);
+    }
+    in.stars = {BakedStar{{star, {1.0f, 1.0f, 1.0f}}, &depth}};
     CameraSettings cs;
     cs.projection = Projection::Orthographic;
     cs.position = {0, 0, -10};
@@ -100,7 +105,7 @@ TEST(PyramidRender, EmissionIsCarriedToEveryLevel) {
         if (z >= 8 && z < 24) emission[grid.shape.index(x, y, z)] = 0.5f;  // 16 voxels deep
   RenderInputs in;
   in.density = &grid;
-  in.bands = {RenderBand{"V", 1.0f, 0.0f, nullptr, &emission}};
+  in.bands = {RenderBand{{"V", 1.0f, 0.0f}, nullptr, &emission}};
   CameraSettings cs;
   cs.projection = Projection::Orthographic;
   cs.position = {0, 0, -10};
@@ -124,7 +129,7 @@ TEST(PyramidRender, EmissionIsCarriedToEveryLevel) {
 // and "changes little" in absolute terms, as the paper's images show it: the
 // layer behind gains less than half the light the layer in front gains.
 // (Relative to its own, faint, back-scattered light it gains more:
-// raycast/README.md gives the numbers.)
+// docs/marcher.md gives the numbers.)
 TEST(PyramidRender, ALayerInFrontOfTheStarGetsBrighterAndBluerOneBehindChangesLittle) {
   const float tau_v = 0.25f;  // per voxel edge; the layer is 6 voxels (tau_V 1.5) thick
   LayerScene front(-0.45f, -0.05f, tau_v), behind(0.05f, 0.45f, tau_v);

@@ -1,13 +1,13 @@
+#include "pipeline/axial_map_source.h"
+
 #include <cctype>
-#include <cstdio>
 #include <filesystem>
 
-#include "app/axial_render.h"
 #include "core/error.h"
 #include "imageio/image_output.h"
 #include "scene/density_sources.h"
 
-namespace nebula::app {
+namespace nebula {
 namespace {
 
 // An image map: column ix is x along the axis, the bottom row is the axis
@@ -95,4 +95,4 @@ AxialMap build_axial_map(const Scene& scene) {
   return m;
 }
 
-}  // namespace nebula::app
+}  // namespace nebula

@@ -2,7 +2,7 @@
 // dataset (with emission datasets), and an image with named channels.
 #include <gtest/gtest.h>
 
-#include "app/axial_render.h"
+#include "pipeline/axial_map_source.h"
 #include "core/error.h"
 #include "imageio/image_output.h"
 #include "scene/scene_file.h"
@@ -21,7 +21,7 @@ class AxialMapSource : public testing::TempDirTest {
 };
 
 TEST_F(AxialMapSource, Synthetic) {
-  const AxialMap m = app::build_axial_map(scene("synthetic = \"shells\"\nnx = 40\nnr = 20\ntau_scale = 2.0"));
+  const AxialMap m = build_axial_map(scene("synthetic = \"shells\"\nnx = 40\nnr = 20\ntau_scale = 2.0"));
   const AxialMap ref = synthetic_axial_map("shells", 40, 20, 1.0f, 2);
   EXPECT_EQ(m.nx, 40);
   EXPECT_FLOAT_EQ(m.texel, 0.05f);
@@ -41,7 +41,7 @@ TEST_F(AxialMapSource, Hdf5DatasetsWithEmission) {
   glow_b.name = "glow_B";
   glow_v.name = "glow_V";
   testing::write_h5(path("map.h5"), {tau, glow_b, glow_v});
-  const AxialMap m = app::build_axial_map(scene("file = \"map.h5\"\nemission_prefix = \"glow_\"\nemission_scale = 2.0"));
+  const AxialMap m = build_axial_map(scene("file = \"map.h5\"\nemission_prefix = \"glow_\"\nemission_scale = 2.0"));
   EXPECT_EQ(m.nx, 5);
   EXPECT_EQ(m.nr, 3);
   EXPECT_FLOAT_EQ(m.texel, 0.4f);
@@ -52,7 +52,7 @@ TEST_F(AxialMapSource, Hdf5DatasetsWithEmission) {
   glow_v.dims = {3, 4};
   glow_v.values.resize(12);
   testing::write_h5(path("bad.h5"), {tau, glow_b, glow_v});
-  testing::expect_error([&] { app::build_axial_map(scene("file = \"bad.h5\"\nemission_prefix = \"glow_\"")); },
+  testing::expect_error([&] { build_axial_map(scene("file = \"bad.h5\"\nemission_prefix = \"glow_\"")); },
                         {"axial.file", "glow_V", "3 x 4"});
 }
 
@@ -64,7 +64,7 @@ TEST_F(AxialMapSource, ImageChannelsWithTheAxisAtTheBottom) {
       image.at(1, x, y) = 1.0f;
     }
   write_image(image, path("map.h5"), ImageMetadata{}, false);
-  const AxialMap m = app::build_axial_map(
+  const AxialMap m = build_axial_map(
       scene("image = \"map.h5\"\ntau_channel = \"dust\"\nemission_channels = { B = \"blue\" }"));
   EXPECT_EQ(m.nx, 4);
   EXPECT_EQ(m.nr, 3);
@@ -73,7 +73,7 @@ TEST_F(AxialMapSource, ImageChannelsWithTheAxisAtTheBottom) {
   ASSERT_EQ(m.emission.size(), 2u);
   EXPECT_FLOAT_EQ(m.emission[0][0], 1.0f);
   EXPECT_FLOAT_EQ(m.emission[1][0], 0.0f);  // V has no channel
-  testing::expect_error([&] { app::build_axial_map(scene("image = \"map.h5\"")); },
+  testing::expect_error([&] { build_axial_map(scene("image = \"map.h5\"")); },
                         {"axial.tau_channel", "'tau_v'", "dust, blue"});
 }
 
@@ -84,7 +84,7 @@ TEST_F(AxialMapSource, AnyOpenImageIoFormat) {
   for (int y = 0; y < 4; ++y)
     for (int x = 0; x < 6; ++x) image.at(1, x, y) = x == 0 ? 0.0f : 0.5f;
   write_image(image, path("map.png"), ImageMetadata{}, false);
-  const AxialMap m = app::build_axial_map(scene("image = \"map.png\"\ntau_channel = \"G\""));
+  const AxialMap m = build_axial_map(scene("image = \"map.png\"\ntau_channel = \"G\""));
   EXPECT_EQ(m.nx, 6);
   EXPECT_EQ(m.nr, 4);
   EXPECT_EQ(m.tau_v[m.index(0, 2)], 0.0f);
@@ -92,7 +92,7 @@ TEST_F(AxialMapSource, AnyOpenImageIoFormat) {
   EXPECT_LE(m.tau_v[m.index(3, 2)], 1.0f);
   EXPECT_EQ(m.height[0], 0);
   EXPECT_EQ(m.height[3], 4);
-  testing::expect_error([&] { app::build_axial_map(scene("image = \"map.png\"\ntau_channel = \"V\"")); },
+  testing::expect_error([&] { build_axial_map(scene("image = \"map.png\"\ntau_channel = \"V\"")); },
                         {"axial.tau_channel", "'V'", "R, G, B"});
 }
 

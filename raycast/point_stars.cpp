@@ -8,7 +8,7 @@
 
 namespace nebula {
 
-void draw_point_stars(const DensityGrid& grid, const std::vector<PointStar>& stars,
+void draw_point_stars(const DensityGrid& grid, const std::vector<StarLight>& stars,
                       const std::vector<float>& extinction_ratios, const Camera& cam, float exposure,
                       double sigma, Image& image) {
   if (stars.empty()) return;
@@ -17,7 +17,7 @@ void draw_point_stars(const DensityGrid& grid, const std::vector<PointStar>& sta
   if (!(sigma > 0)) throw Error("output.star_psf_pixels: must be positive");
   const double pixel_angle = 2.0 * cam.tan_half_fov / cam.height;  // radians per pixel at the centre
   const int radius = static_cast<int>(std::ceil(4 * sigma));
-  for (const PointStar& star : stars) {
+  for (const StarLight& star : stars) {
     const Vec3 d = star.position - cam.position;
     const float along = dot(d, cam.forward);
     if (!(along > 0)) continue;  // behind the camera

@@ -4,20 +4,17 @@
 // as radiance (flux over each pixel's solid angle).
 #include <vector>
 
+#include "core/bands.h"
+#include "core/camera.h"
 #include "core/grid.h"
 #include "core/image.h"
-#include "raycast/camera.h"
 
 namespace nebula {
 
-struct PointStar {
-  Vec3 position;
-  std::vector<float> power;  // per band, L_sun
-};
-
-// Adds the stars to `image` (bands in the order of `extinction_ratios`).
+// Adds the stars to `image` (bands in the order of `extinction_ratios`, each
+// star's power in that order).
 // Perspective cameras only; throws Error otherwise.
-void draw_point_stars(const DensityGrid& grid, const std::vector<PointStar>& stars,
+void draw_point_stars(const DensityGrid& grid, const std::vector<StarLight>& stars,
                       const std::vector<float>& extinction_ratios, const Camera& camera, float exposure,
                       double psf_sigma_pixels, Image& image);
 

@@ -5,6 +5,7 @@
 // Written once for host and device.
 #include <cstdint>
 
+#include "core/bands.h"
 #include "core/dda.h"
 #include "core/grid.h"
 #include "core/hd.h"
@@ -13,14 +14,12 @@
 
 namespace nebula {
 
-constexpr int kMaxBands = 4;
-
-// One star as the marcher sees it: band powers and its baked V-band depth
-// to every voxel sphere.
+// One star as a marcher sees it (this one and the axial one): band powers and
+// its baked V-band depth to every cell's sphere (voxel or texel).
 struct StarView {
   Vec3 position;
   float power[kMaxBands];  // band luminosity, L_sun
-  const float* depth_v;    // [voxel]
+  const float* depth_v;    // [cell]
 };
 
 // Everything a ray needs, by value (pointers to host or device memory).
@@ -41,6 +40,17 @@ struct RayResult {
   float transmittance[kMaxBands];
   int table_clamps;
 };
+
+// One ray's radiance times the exposure, stored at pixel (x, y) of an image of
+// n_bands planes of width x height ([band][y][x], host or device memory): the
+// pixel write of every marcher's CPU loop and CUDA kernel.
+NEBULA_HD void store_radiance(const RayResult& r, int n_bands, float exposure, float* pixels, int width, int height,
+                              int x, int y) {
+  const size_t plane = size_t(width) * height;
+  NEBULA_UNROLL
+  for (int b = 0; b < kMaxBands; ++b)
+    if (b < n_bands) pixels[b * plane + size_t(y) * width + x] = exposure * r.radiance[b];
+}
 
 // One star's light that dust at `pos` (V-band depth tau_v per cell edge
 // `edge`) sends towards the eye per band, per unit of chord / edge, added to

@@ -7,7 +7,9 @@
 #include <chrono>
 
 #include "core/error.h"
+#include "core/placement.h"
 #include "core/progress.h"
+#include "raycast/march_scene.h"
 
 namespace nebula {
 
@@ -24,37 +26,16 @@ void validate(const RenderInputs& in) {
     if (b.emission && b.emission->size() != voxels)
       throw Error("render: emission of band " + b.name + " does not match the density grid");
   }
-  for (const RenderStar& s : in.stars) {
+  for (const BakedStar& s : in.stars) {
     if (s.power.size() != in.bands.size()) throw Error("render: a star lacks band powers");
     if (!s.depth_v || s.depth_v->size() != voxels) throw Error("render: a star has no baked depth");
   }
 }
 
 Image render_cpu(const RenderInputs& in, RenderStats* stats) {
-  validate(in);
-  MarchScene scene{};
-  scene.density = in.density->view();
-  scene.n_bands = static_cast<int>(in.bands.size());
-  scene.min_transmittance = in.min_transmittance;
-  for (int b = 0; b < scene.n_bands; ++b) {
-    const RenderBand& band = in.bands[b];
-    scene.extinction_ratio[b] = band.extinction_ratio;
-    scene.albedo[b] = band.albedo;
-    scene.table[b] = band.table ? view_of(*band.table) : TableView{};
-    scene.emission[b] = band.emission ? band.emission->data() : nullptr;
-  }
-  std::vector<StarView> stars(in.stars.size());
-  for (size_t k = 0; k < stars.size(); ++k) {
-    stars[k].position = in.stars[k].position;
-    for (int b = 0; b < scene.n_bands; ++b) stars[k].power[b] = in.stars[k].power[b];
-    stars[k].depth_v = in.stars[k].depth_v->data();
-  }
-  scene.stars = stars.data();
-  scene.n_stars = static_cast<int>(stars.size());
-
-  std::vector<std::string> names;
-  for (const RenderBand& b : in.bands) names.push_back(b.name);
-  Image image(in.camera.width, in.camera.height, names);
+  HostPlacement host;
+  const MarchScene scene = assemble_march_scene(in, host);
+  Image image(in.camera.width, in.camera.height, band_names(in.bands));
   std::atomic<uint64_t> clamps{0};
   const auto start = std::chrono::steady_clock::now();
   tbb::parallel_for(tbb::blocked_range<int>(0, in.camera.height), [&](const auto& rows) {
@@ -64,7 +45,7 @@ Image render_cpu(const RenderInputs& in, RenderStats* stats) {
         Vec3 origin, dir;
         if (!in.camera.ray(x, y, origin, dir)) continue;
         const RayResult r = march_ray(scene, origin, dir, in.mode);
-        for (int b = 0; b < scene.n_bands; ++b) image.at(b, x, y) = in.exposure * r.radiance[b];
+        store_radiance(r, scene.n_bands, in.exposure, image.pixels.data(), image.width, image.height, x, y);
         local_clamps += r.table_clamps;
       }
     clamps += local_clamps;

@@ -1,13 +1,15 @@
 #pragma once
 // Renders an image of a voxel grid lit by stars, on the CPU (TBB) or the GPU
-// (CUDA); both run march_ray per pixel.
+// (CUDA); both run march_ray per pixel over the scene assembled once by
+// assemble_march_scene (raycast/march_scene.h).
 #include <string>
 #include <vector>
 
 #include "core/backend.h"
+#include "core/bands.h"
+#include "core/camera.h"
 #include "core/grid.h"
 #include "core/image.h"
-#include "raycast/camera.h"
 #include "raycast/ray_march.h"
 #include "tables/scattering_table.h"
 
@@ -15,24 +17,17 @@ namespace nebula {
 
 class Progress;
 
-struct RenderBand {
-  std::string name;             // "B", "V", "R"
-  float extinction_ratio = 1;   // A_b / A_V
-  float albedo = 0.6f;
-  const ScatteringTable* table = nullptr;  // required when albedo > 0
+// A band as the ray marcher reads it: a band with albedo > 0 scatters and
+// needs a table; a band with albedo 0 reads none.
+struct RenderBand : Band {
+  const ScatteringTable* table = nullptr;
   const std::vector<float>* emission = nullptr;  // j per voxel, or null
-};
-
-struct RenderStar {
-  Vec3 position;
-  std::vector<float> power;            // per band, L_sun
-  const std::vector<float>* depth_v;   // baked V-band depth per voxel
 };
 
 struct RenderInputs {
   const DensityGrid* density = nullptr;
   std::vector<RenderBand> bands;
-  std::vector<RenderStar> stars;
+  std::vector<BakedStar> stars;  // depth_v: the baked V-band depth per voxel
   Camera camera;
   float exposure = 1.0f;
   float min_transmittance = 1e-4f;
@@ -49,6 +44,12 @@ struct RenderStats {
 Image render(const RenderInputs& in, Backend backend, RenderStats* stats = nullptr);
 Image render_cpu(const RenderInputs& in, RenderStats* stats);
 Image render_cuda(const RenderInputs& in, RenderStats* stats);
+
+// The CUDA path's frame for renderers built on this one (multires/): marches
+// every pixel of in.camera into `device_pixels` (bands x height x width,
+// device memory), adds the table clamps to *device_clamps (device memory) and
+// returns the kernel's time (CUDA events).
+double render_cuda_to_device(const RenderInputs& in, float* device_pixels, unsigned long long* device_clamps);
 
 // Host-side checks shared by both backends.
 void validate(const RenderInputs& in);

@@ -1,15 +1,10 @@
-#include "core/error.h"
-#include "raycast/pyramid_render.h"
+#include "core/gpu.h"
 #include "raycast/renderer.h"
 
 namespace nebula {
 
-Image render_cuda(const RenderInputs&, RenderStats*) {
-  throw Error("--backend cuda: this build has no CUDA backend (configured without a CUDA compiler)");
-}
+Image render_cuda(const RenderInputs&, RenderStats*) { no_cuda_backend(); }
 
-PyramidResult render_pyramid_cuda(const RenderInputs&, const PreparedPyramid&, bool) {
-  throw Error("--backend cuda: this build has no CUDA backend (configured without a CUDA compiler)");
-}
+double render_cuda_to_device(const RenderInputs&, float*, unsigned long long*) { no_cuda_backend(); }
 
 }  // namespace nebula

@@ -123,7 +123,7 @@ TEST(Renderer, PureExtinctionThroughASlab) {
     in.density = &grid;
     const float ratios[3] = {1.3f, 1.0f, 0.8f};
     for (int b = 0; b < 3; ++b)
-      in.bands.push_back(RenderBand{std::string(1, "BVR"[b]), ratios[b], 0.0f, nullptr, &emission});
+      in.bands.push_back(RenderBand{{std::string(1, "BVR"[b]), ratios[b], 0.0f}, nullptr, &emission});
     in.camera = telescope(16, 6.0f);
     return render_cpu(in, nullptr);
   };
@@ -190,7 +190,9 @@ TEST(Renderer, HardCasesStayFinite) {
       if (albedo > 0) EXPECT_GT(sum, 0.0) << "a camera inside a lit cloud sees light";
       else EXPECT_EQ(sum, 0.0);
       // The tau = 1000 voxel leaves the table's range, and is counted.
-      if (albedo > 0) EXPECT_GT(stats.table_clamps, 0u);
+      if (albedo > 0) {
+        EXPECT_GT(stats.table_clamps, 0u);
+      }
     }
   }
 }
@@ -270,7 +272,9 @@ TEST(Renderer, SmoothModeConvergesToTheExactTraversal) {
     for (size_t i = 0; i < exact.pixels.size(); ++i) diff += std::fabs(smooth.pixels[i] - exact.pixels[i]);
     diff /= norm;
     std::printf("smooth mode (voxel values), step %.4g voxel: relative L1 difference %.3g\n", step, diff);
-    if (previous > 0) EXPECT_LT(diff, previous / 1.5);
+    if (previous > 0) {
+      EXPECT_LT(diff, previous / 1.5);
+    }
     previous = diff;
   }
   EXPECT_LT(previous, 0.0625);
@@ -304,7 +308,7 @@ TEST(PointStars, StarBehindASlabDimsByItsOpticalDepth) {
   cs.fov_deg = 10;
   cs.width = cs.height = 64;
   const Camera camera = make_camera(cs);
-  const std::vector<PointStar> stars{{{0.1f, 0.0f, 4.0f}, {1.0f, 2.0f, 3.0f}}};
+  const std::vector<StarLight> stars{{{0.1f, 0.0f, 4.0f}, {1.0f, 2.0f, 3.0f}}};
   const std::vector<float> ratios{1.3f, 1.0f, 0.8f};
   auto flux = [&](float tau_v) {
     std::fill(grid.tau_v.begin(), grid.tau_v.end(), tau_v);

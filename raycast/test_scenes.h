@@ -50,8 +50,8 @@ struct OneStarScene {
   void finish(Vec3 star, float power, float albedo, const Camera& camera) {
     depth = bake_star_depths_cpu(grid, {star}).tau_v[0];
     inputs.density = &grid;
-    inputs.bands = {RenderBand{"V", 1.0f, albedo, &table, nullptr}};
-    inputs.stars = {RenderStar{star, {power}, &depth}};
+    inputs.bands = {RenderBand{{"V", 1.0f, albedo}, &table, nullptr}};
+    inputs.stars = {BakedStar{{star, {power}}, &depth}};
     inputs.camera = camera;
   }
 };

@@ -5,19 +5,18 @@
 #include <set>
 
 #include "core/error.h"
+#include "illumination/filters.h"
 #include "illumination/star.h"
 #include "scene/density_sources.h"
 #include "scene/scene_checks.h"
 
 namespace nebula {
 
-const char* to_string(CameraKind kind) {
-  switch (kind) {
-    case CameraKind::Perspective: return "perspective";
-    case CameraKind::Orthographic: return "orthographic";
-    case CameraKind::Fisheye: return "fisheye";
-  }
-  return "unknown";
+CameraSettings scene_camera_defaults() {
+  CameraSettings c;
+  c.position = c.look_at = Vec3{0, 0, 0};
+  c.up = Vec3{0, 0, 1};
+  return c;
 }
 
 namespace scene_detail {
@@ -42,53 +41,6 @@ std::optional<SceneIssue> per_band_issue(const Scene& s, const std::vector<doubl
     if (!(std::isfinite(values[b]) && good(values[b])))
       return SceneIssue{all_equal(values) ? "dust." + name : "dust." + name + "." + s.bands[b],
                         "is " + to_text(values[b]) + "; must be " + range};
-  return std::nullopt;
-}
-
-std::optional<SceneIssue> camera_issue(const CameraSpec& c) {
-  if (!finite(c.position)) return SceneIssue{"camera.position", "must be finite"};
-  if (!finite(c.look_at)) return SceneIssue{"camera.look_at", "must be finite"};
-  if (!finite(c.up)) return SceneIssue{"camera.up", "must be finite"};
-  const double dx = double(c.look_at.x) - c.position.x, dy = double(c.look_at.y) - c.position.y,
-               dz = double(c.look_at.z) - c.position.z;
-  const double view = std::sqrt(dx * dx + dy * dy + dz * dz);
-  const double scale = std::fmax(1.0, std::sqrt(double(dot(c.position, c.position))));
-  if (!(view > 1e-6 * scale))
-    return SceneIssue{"camera.look_at", "equals camera.position " + vec_text(c.position) +
-                                            ": the view direction has zero length"};
-  const double ux = c.up.x, uy = c.up.y, uz = c.up.z;
-  const double up = std::sqrt(ux * ux + uy * uy + uz * uz);
-  if (!(up > 0)) return SceneIssue{"camera.up", "must not be the zero vector"};
-  // |d x u| / (|d| |u|) = sin of the angle between them.
-  const double cx = dy * uz - dz * uy, cy = dz * ux - dx * uz, cz = dx * uy - dy * ux;
-  const double sine = std::sqrt(cx * cx + cy * cy + cz * cz) / (view * up);
-  if (!(sine > 1e-6))
-    return SceneIssue{"camera.up", "is " + vec_text(c.up) +
-                                       ", parallel to the view direction (look_at - position); "
-                                       "choose an up vector across it"};
-  if (!(std::isfinite(c.fov_deg) && c.fov_deg > 0 && c.fov_deg < 180))
-    return SceneIssue{"camera.fov_deg", "is " + to_text(c.fov_deg) + "; must be in (0, 180)"};
-  if (c.kind == CameraKind::Orthographic) {
-    if (!(std::isfinite(c.ortho_width) && c.ortho_width > 0))
-      return SceneIssue{"camera.ortho_width", "is " + to_text(c.ortho_width) +
-                                                  "; an orthographic camera needs a width "
-                                                  "(parsecs across the image) > 0"};
-  } else if (!(std::isfinite(c.ortho_width) && c.ortho_width >= 0)) {
-    return SceneIssue{"camera.ortho_width", "is " + to_text(c.ortho_width) + "; must be >= 0"};
-  }
-  if (c.width < 1) return SceneIssue{"camera.width", "is " + std::to_string(c.width) + "; must be >= 1"};
-  if (c.height < 1) return SceneIssue{"camera.height", "is " + std::to_string(c.height) + "; must be >= 1"};
-  constexpr int kMaxPixels = 1 << 16;
-  if (c.width > kMaxPixels)
-    return SceneIssue{"camera.width", "is " + std::to_string(c.width) + "; must be <= 65536"};
-  if (c.height > kMaxPixels)
-    return SceneIssue{"camera.height", "is " + std::to_string(c.height) + "; must be <= 65536"};
-  if (c.kind == CameraKind::Fisheye && c.width != c.height)
-    return SceneIssue{"camera.height", "is " + std::to_string(c.height) + " but width is " +
-                                           std::to_string(c.width) +
-                                           "; a fisheye dome master must be square"};
-  if (!(std::isfinite(c.exposure) && c.exposure > 0))
-    return SceneIssue{"camera.exposure", "is " + to_text(c.exposure) + "; must be > 0"};
   return std::nullopt;
 }
 
@@ -118,14 +70,18 @@ std::optional<SceneIssue> star_issue(const SceneStar& star, const std::string& k
 
 }  // namespace
 
-bool known_band(const std::string& band) { return band == "B" || band == "V" || band == "R"; }
+std::optional<SceneIssue> band_issue(const std::string& band) {
+  if (is_renderable_filter(band)) return std::nullopt;
+  std::string known;
+  for (const std::string& name : renderable_filters()) known += (known.empty() ? "" : ", ") + name;
+  return SceneIssue{"bands", "'" + band + "' is not a known band (known: " + known + ")"};
+}
 
 std::optional<SceneIssue> settings_issue(const Scene& s) {
   if (s.bands.empty()) return SceneIssue{"bands", "must name at least one band"};
   std::set<std::string> seen;
   for (const std::string& band : s.bands) {
-    if (!known_band(band))
-      return SceneIssue{"bands", "'" + band + "' is not a known band (known: B, V, R)"};
+    if (auto issue = band_issue(band)) return issue;
     if (!seen.insert(band).second) return SceneIssue{"bands", "'" + band + "' appears twice"};
   }
   if (auto issue = per_band_issue(s, s.dust.albedo, "albedo", "in [0, 1]",
@@ -144,7 +100,7 @@ std::optional<SceneIssue> settings_issue(const Scene& s) {
                                          " bands"};
   for (size_t i = 0; i < s.stars.size(); ++i)
     if (auto issue = star_issue(s.stars[i], "stars." + std::to_string(i))) return issue;
-  if (auto issue = camera_issue(s.camera)) return issue;
+  if (auto issue = camera_issue(s.camera)) return SceneIssue{"camera." + issue->field, issue->reason};
   if (s.output.empty()) return SceneIssue{"output.file", "must not be empty"};
   if (!(std::isfinite(s.star_psf_pixels) && s.star_psf_pixels > 0 && s.star_psf_pixels <= 1000))
     return SceneIssue{"output.star_psf_pixels",

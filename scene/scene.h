@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/camera.h"
 #include "core/grid.h"
 #include "core/vec3.h"
 #include "illumination/extinction.h"
@@ -37,23 +38,14 @@ struct SceneStar {
   std::string spectral_class;  // as written in the scene ("" when only a temperature was given)
 };
 
-enum class CameraKind { Perspective, Orthographic, Fisheye };
-
-const char* to_string(CameraKind kind);  // "perspective", "orthographic", "fisheye"
-
-struct CameraSpec {
-  CameraKind kind = CameraKind::Perspective;
-  Vec3 position, look_at, up{0, 0, 1};
-  double fov_deg = 40;     // perspective: full vertical field of view, (0, 180)
-  double ortho_width = 0;  // orthographic: world units (pc) across the image width, > 0
-  int width = 512, height = 512;  // pixels; fisheye (180 deg dome master) needs width == height
-  double exposure = 1.0;          // radiance multiplier, > 0
-};
+// The scene's camera is the one camera model (core/camera.h): CameraSettings,
+// with a scene file's defaults: up = +z (a scene file's [camera] table).
+CameraSettings scene_camera_defaults();
 
 // An axial-symmetric nebula ([axial] in a scene file, docs/scene.md): a 2D
 // map M(x, r) rotated about an axis, given instead of [density]. The scene
-// holds where the map comes from; app/axial_render.cpp builds it
-// (raycast/axial_map.h) and renders it with raycast/axial_renderer.h.
+// holds where the map comes from; the pipeline builds it
+// (pipeline/axial_map_source.h) and renders it with axial/axial_renderer.h.
 struct AxialSpec {
   std::string source;              // "synthetic", "file" (HDF5) or "image"
   std::string synthetic;           // bipolar, lopsided, shells, empty, full
@@ -83,7 +75,7 @@ struct Scene {
   std::vector<std::vector<float>> emission;
   DustParams dust;
   std::vector<SceneStar> stars;
-  CameraSpec camera;
+  CameraSettings camera = scene_camera_defaults();
   std::string output = "nebula.exr";  // as written; relative to the working directory
   bool draw_stars = false;
   double star_psf_pixels = 1.5;  // Gaussian sigma of a drawn star, pixels

@@ -26,8 +26,8 @@ std::optional<SceneIssue> settings_issue(const Scene& scene);
 // The density and emission grids: shapes, sizes and values.
 std::optional<SceneIssue> grids_issue(const Scene& scene);
 
-// "B", "V" or "R": the bands with passbands and extinction ratios.
-bool known_band(const std::string& band);
+// A band a scene may render (illumination/filters.h), or its issue.
+std::optional<SceneIssue> band_issue(const std::string& band);
 
 inline std::string number_text(double v) { return to_text(v); }
 

@@ -228,7 +228,7 @@ class Parser {
   std::optional<EmissionPlan> parse_emission(const toml::table& root) const;
   DustParams parse_dust(const toml::table& root, const std::vector<std::string>& bands) const;
   std::vector<SceneStar> parse_stars(const toml::table& root, const DensityPlan& density) const;
-  CameraSpec parse_camera(const toml::table& root) const;
+  CameraSettings parse_camera(const toml::table& root) const;
   void parse_output(const toml::table& root, Scene& scene) const;
   void parse_render(const toml::table& root, Scene& scene) const;
   void load_grids(const DensityPlan& density, const std::optional<EmissionPlan>& emission,
@@ -328,8 +328,7 @@ std::vector<std::string> Parser::parse_bands(const toml::table& root) const {
   for (size_t i = 0; i < a->size(); ++i) bands.push_back(string((*a)[i], "bands[" + std::to_string(i) + "]"));
   if (bands.empty()) fail("bands", "must name at least one band");
   for (size_t i = 0; i < bands.size(); ++i) {
-    if (!scene_detail::known_band(bands[i]))
-      fail("bands", "'" + bands[i] + "' is not a known band (known: B, V, R)");
+    if (auto issue = scene_detail::band_issue(bands[i])) fail(issue->key, issue->reason);
     for (size_t j = 0; j < i; ++j)
       if (bands[j] == bands[i]) fail("bands", "'" + bands[i] + "' appears twice");
   }
@@ -609,24 +608,16 @@ std::vector<SceneStar> Parser::parse_stars(const toml::table& root, const Densit
   return stars;
 }
 
-CameraSpec Parser::parse_camera(const toml::table& root) const {
+CameraSettings Parser::parse_camera(const toml::table& root) const {
   const toml::node* n = root.get("camera");
   if (n == nullptr) fail("camera", "missing required table [camera] (position and look_at)");
   const toml::table& t = table_at(*n, "camera");
   known_keys(t, "camera", kCameraKeys);
-  CameraSpec c;
-  if (const toml::node* k = t.get("kind")) {
-    const std::string kind = lower(string(*k, "camera.kind"));
-    if (kind == "perspective")
-      c.kind = CameraKind::Perspective;
-    else if (kind == "orthographic")
-      c.kind = CameraKind::Orthographic;
-    else if (kind == "fisheye")
-      c.kind = CameraKind::Fisheye;
-    else
+  CameraSettings c = scene_camera_defaults();
+  if (const toml::node* k = t.get("kind"))
+    if (!parse_projection(lower(string(*k, "camera.kind")), c.projection))
       fail("camera.kind", "'" + string(*k, "camera.kind") +
                               "' is not a camera kind (known: perspective, orthographic, fisheye)");
-  }
   for (const char* required : {"position", "look_at"})
     if (t.get(required) == nullptr)
       fail(std::string("camera.") + required, "missing required key ([x, y, z] in parsecs)");
@@ -635,7 +626,7 @@ CameraSpec Parser::parse_camera(const toml::table& root) const {
   if (const toml::node* v = t.get("up")) c.up = vec3(*v, "camera.up");
   if (const toml::node* v = t.get("fov_deg")) c.fov_deg = number(*v, "camera.fov_deg");
   if (const toml::node* v = t.get("ortho_width")) c.ortho_width = number(*v, "camera.ortho_width");
-  else if (c.kind == CameraKind::Orthographic)
+  else if (c.projection == Projection::Orthographic)
     fail("camera.ortho_width", "missing: an orthographic camera needs the width of its view in parsecs");
   if (const toml::node* v = t.get("width")) c.width = small_integer(*v, "camera.width");
   if (const toml::node* v = t.get("height")) c.height = small_integer(*v, "camera.height");
@@ -796,7 +787,7 @@ Scene demo_scene() {
   star.spectral_class = "O5V";
   star.temperature_K = effective_temperature_K("O5V");
   scene.stars.push_back(star);
-  scene.camera.kind = CameraKind::Perspective;
+  scene.camera.projection = Projection::Perspective;
   scene.camera.position = Vec3{1.0f, -2.5f, 1.3f};
   scene.camera.look_at = star.position;
   scene.camera.up = Vec3{0, 0, 1};

@@ -90,7 +90,7 @@ TEST_F(SceneFile, BaseSceneLoadsWithDefaults) {
   EXPECT_EQ(s.stars[0].temperature_K, 41400.0);
   EXPECT_EQ(s.stars[0].spectral_class, "O5V");
   EXPECT_EQ(s.stars[0].luminosity_lsun, 2e5);
-  EXPECT_EQ(s.camera.kind, CameraKind::Perspective);
+  EXPECT_EQ(s.camera.projection, Projection::Perspective);
   EXPECT_EQ(s.camera.up.z, 1.0f);
   EXPECT_EQ(s.camera.fov_deg, 40.0);
   EXPECT_EQ(s.camera.width, 512);
@@ -173,7 +173,7 @@ star_psf_pixels = 2.0
   EXPECT_EQ(s.stars[0].spectral_class, "");
   EXPECT_EQ(s.stars[1].temperature_K, 5770.0);
   EXPECT_FLOAT_EQ(s.stars[1].position.x, 1.5f);
-  EXPECT_EQ(s.camera.kind, CameraKind::Orthographic);
+  EXPECT_EQ(s.camera.projection, Projection::Orthographic);
   EXPECT_EQ(s.camera.ortho_width, 2.5);
   EXPECT_EQ(s.camera.width, 640);
   EXPECT_EQ(s.camera.height, 480);
@@ -363,7 +363,7 @@ TEST_F(SceneFile, OverridesApplyBeforeValidation) {
   EXPECT_EQ(s.dust.albedo, std::vector<double>(3, 0.8));
   EXPECT_EQ(s.stars[0].luminosity_lsun, 1e4);
   EXPECT_EQ(s.stars[0].name, "renamed");
-  EXPECT_EQ(s.camera.kind, CameraKind::Fisheye);
+  EXPECT_EQ(s.camera.projection, Projection::Fisheye);
   EXPECT_TRUE(s.draw_stars);
   EXPECT_EQ(s.dust.g, (std::vector<double>{0.7, 0.6, 0.5}));
   EXPECT_FLOAT_EQ(s.camera.position.y, -4.0f);
@@ -430,8 +430,8 @@ void expect_same_scene(const Scene& a, const Scene& b) {
     EXPECT_EQ(a.stars[i].temperature_K, b.stars[i].temperature_K);
     EXPECT_EQ(a.stars[i].spectral_class, b.stars[i].spectral_class);
   }
-  const CameraSpec &c = a.camera, &d = b.camera;
-  EXPECT_EQ(c.kind, d.kind);
+  const CameraSettings &c = a.camera, &d = b.camera;
+  EXPECT_EQ(c.projection, d.projection);
   for (auto [p, q] : {std::pair{c.position, d.position}, {c.look_at, d.look_at}, {c.up, d.up}}) {
     EXPECT_EQ(p.x, q.x);
     EXPECT_EQ(p.y, q.y);
@@ -528,7 +528,7 @@ TEST(Scene, ValidateSceneNamesTheKey) {
   s = demo_scene();
   s.dust.g.pop_back();
   expect_error([&] { validate_scene(s); }, {"demo", "dust.g", "2 values for 3 bands"});
-  EXPECT_STREQ(to_string(CameraKind::Fisheye), "fisheye");
+  EXPECT_STREQ(to_string(Projection::Fisheye), "fisheye");
 }
 
 }  // namespace

@@ -10,7 +10,7 @@ namespace nebula {
 struct ScatteringTable;
 
 // A non-owning view of P for lookups on host or device: P points to host
-// memory (view_of) or device memory (DeviceTable::view).
+// memory (view_of) or device memory (place_table with a device placement).
 struct TableView {
   const float* P = nullptr;  // row-major [n_tau][n_mu]
   int n_tau = 0;
@@ -96,5 +96,14 @@ static_assert(std::is_trivially_copyable_v<TableView>);
 // or n_tau < 2, so lookups can never read out of bounds. The table must
 // outlive the view.
 TableView view_of(const ScatteringTable& table);
+
+// The view of `table` with P placed by `place` (core/placement.h): the
+// table's own array on the host, a device copy on the GPU.
+template <class Table, class Place>
+TableView place_table(const Table& table, Place& place) {
+  TableView view = view_of(table);
+  view.P = place.place(table.P);
+  return view;
+}
 
 }  // namespace nebula

@@ -10,7 +10,7 @@
 
 #include "core/error.h"
 #include "core/gpu.h"
-#include "tables/device_table.h"
+#include "tables/table_lookup_gpu.h"
 #include "tables/table_lookup.h"
 #include "tables/test_tables.h"
 
@@ -96,21 +96,6 @@ TEST(TableLookupGpu, AgreesWithTheHost) {
                           << mu[worst_at] << ": host " << expected[worst_at] << " GPU "
                           << got[worst_at];
   }
-}
-
-TEST(TableLookupGpu, DeviceTableViewKeepsTheShape) {
-  SKIP_WITHOUT_GPU();
-  const ScatteringTable t = make_test_table(5.0, 11, AngularBinning::UniformTheta, 36);
-  DeviceTable device(t);
-  const TableView v = device.view();
-  EXPECT_NE(v.P, nullptr);
-  EXPECT_NE(v.P, t.P.data());
-  EXPECT_EQ(v.n_tau, 11);
-  EXPECT_EQ(v.n_mu, 36);
-  EXPECT_EQ(v.tau_max, 5.0f);
-  DeviceTable moved(std::move(device));
-  EXPECT_EQ(moved.view().P, v.P);
-  EXPECT_EQ(device.view().P, nullptr);
 }
 
 TEST(TableLookupGpu, MismatchedInputsAreRefused) {

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "core/error.h"
+#include "core/placement.h"
 #include "tables/scattering_table.h"
 #include "tables/test_tables.h"
 
@@ -39,6 +40,18 @@ TEST(TableLookup, ViewOfCopiesTheShape) {
   EXPECT_EQ(v.tau_max, 5.0f);
   EXPECT_EQ(v.bins.kind, AngularBinning::UniformTheta);
   EXPECT_EQ(v.bins.n, 36);
+}
+
+// A placed view is the same view with P wherever the placement put it: on the
+// host (the CPU path) the table's own array.
+TEST(TableLookup, PlacedViewKeepsTheShape) {
+  const ScatteringTable t = make_test_table(5.0, 11, AngularBinning::UniformTheta, 36);
+  HostPlacement host;
+  const TableView v = place_table(t, host);
+  EXPECT_EQ(v.P, t.P.data());
+  EXPECT_EQ(v.n_tau, 11);
+  EXPECT_EQ(v.n_mu, 36);
+  EXPECT_EQ(host.bytes(), t.P.size() * sizeof(float));
 }
 
 TEST(TableLookup, ViewOfRefusesAMisshapenTable) {

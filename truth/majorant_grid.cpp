@@ -1,4 +1,4 @@
-#include "validation/majorant_grid.h"
+#include "truth/majorant_grid.h"
 
 #include <algorithm>
 #include <string>

@@ -1,8 +1,8 @@
 #pragma once
 // The ground truth (DESIGN.md section 3, "Ground truth"; docs/accuracy.md):
 // an unbiased volumetric path tracer on exactly the scene the fast renderer
-// sees. Written once for host and device; path_tracer.cpp launches it with
-// TBB, path_tracer_cuda.cu with one CUDA thread per pixel.
+// sees. Written once for host and device; truth_renderer.cpp launches it with
+// TBB, truth_renderer_cuda.cu with one CUDA thread per pixel.
 //
 // The medium is piecewise constant per voxel: in band b,
 // sigma_ext = tau_v (A_b/A_V) / l, sigma_sct = a_b sigma_ext, HG(g_b) phase.
@@ -31,6 +31,8 @@
 // finite; the ball has probability ~1e-36).
 #include <cstdint>
 
+#include "core/bands.h"
+#include "core/camera.h"
 #include "core/dda.h"
 #include "core/grid.h"
 #include "core/hd.h"
@@ -38,9 +40,7 @@
 #include "core/philox.h"
 #include "core/vec3.h"
 #include "montecarlo/henyey_greenstein.h"
-#include "raycast/camera.h"
-#include "raycast/ray_march.h"  // kMaxBands
-#include "validation/majorant_grid.h"
+#include "truth/majorant_grid.h"
 
 namespace nebula {
 

@@ -9,7 +9,7 @@
 #include "core/philox.h"
 #include "raycast/test_scenes.h"
 #include "validation/image_compare.h"
-#include "validation/truth_renderer.h"
+#include "truth/truth_renderer.h"
 
 namespace nebula {
 namespace {
@@ -26,10 +26,10 @@ void expect_cpu_and_cuda_agree(bool equiangular) {
   for (size_t i = 0; i < j.size(); i += 7) j[i] = 0.01f;
   TruthInputs in;
   in.density = &g;
-  in.bands = {TruthBand{"B", 1.3f, 0.6f, 0.6f, nullptr}, TruthBand{"V", 1.0f, 0.9f, 0.3f, &j}};
+  in.bands = {TruthBand{{"B", 1.3f, 0.6f, 0.6f}, nullptr}, TruthBand{{"V", 1.0f, 0.9f, 0.3f}, &j}};
   // Stars outside the dust: a star inside it has heavy-tailed samples (docs/truth.md), which
   // would make the chi-square test below depend on a few paths.
-  in.stars = {TruthStar{{0.1f, 0.05f, 1.4f}, {1e3f, 8e2f}}, TruthStar{{0, 3, 0}, {1e3f, 1e3f}}};
+  in.stars = {StarLight{{0.1f, 0.05f, 1.4f}, {1e3f, 8e2f}}, StarLight{{0, 3, 0}, {1e3f, 1e3f}}};
   CameraSettings cs;
   cs.position = {0.3f, -3.0f, 0.8f};
   cs.look_at = {0, 0, 0};

@@ -7,12 +7,13 @@
 #include <cstdio>
 
 #include "core/dda.h"
+#include "core/error.h"
 #include "core/philox.h"
 #include "montecarlo/henyey_greenstein.h"
 #include "raycast/renderer.h"
 #include "raycast/test_scenes.h"
 #include "validation/image_compare.h"
-#include "validation/truth_renderer.h"
+#include "truth/truth_renderer.h"
 
 namespace nebula {
 namespace {
@@ -75,7 +76,7 @@ TEST(PathTracer, RatioTrackingTransmittanceIsUnbiased) {
   DensityGrid g = noise_grid(16, 1.0f, 0.8f, 11);
   TruthInputs in;
   in.density = &g;
-  in.bands = {TruthBand{"V", 1.3f, 0.5f, 0.0f, nullptr}};
+  in.bands = {TruthBand{{"V", 1.3f, 0.5f, 0.0f}, nullptr}};
   in.camera = telescope(4, 1.0f);
   const HostPathScene h = prepare_path_scene(in);
   const float scale = 1.3f / g.shape.voxel;
@@ -103,7 +104,7 @@ TEST(PathTracer, DeltaTrackingCollidesWithProbabilityOneMinusT) {
   DensityGrid g = noise_grid(16, 1.0f, 0.8f, 12);
   TruthInputs in;
   in.density = &g;
-  in.bands = {TruthBand{"V", 0.9f, 0.5f, 0.0f, nullptr}};
+  in.bands = {TruthBand{{"V", 0.9f, 0.5f, 0.0f}, nullptr}};
   in.camera = telescope(4, 1.0f);
   const HostPathScene h = prepare_path_scene(in);
   const Vec3 a{0.91f, -0.73f, -1.5f}, dir = normalize(Vec3{-0.9f, 0.55f, 1.7f});
@@ -137,8 +138,8 @@ TEST(PathTracer, PureExtinctionSlabIsExactAndNoiseless) {
     }
   TruthInputs in;
   in.density = &g;
-  in.bands = {TruthBand{"B", 1.3f, 0.0f, 0.6f, &j_b}, TruthBand{"V", 1.0f, 0.0f, 0.6f, &j_v}};
-  in.stars = {TruthStar{{0, 0, 10}, {1e3f, 1e3f}}};  // behind the layer: a = 0, it lights nothing
+  in.bands = {TruthBand{{"B", 1.3f, 0.0f, 0.6f}, &j_b}, TruthBand{{"V", 1.0f, 0.0f, 0.6f}, &j_v}};
+  in.stars = {StarLight{{0, 0, 10}, {1e3f, 1e3f}}};  // behind the layer: a = 0, it lights nothing
   in.camera = telescope(4, 3.0f, {0, 0, -10}, {0, 0, 3});
   in.spp = 4;
   const TruthOutput out = render_truth_cpu(in);
@@ -171,8 +172,8 @@ void expect_thin_sphere_profile(bool equiangular) {
   fill_sphere(grid, radius, kappa * l);
   TruthInputs in;
   in.density = &grid;
-  in.bands = {TruthBand{"V", 1.0f, albedo, g, nullptr}};
-  in.stars = {TruthStar{{0, 0, 0}, {power}}};
+  in.bands = {TruthBand{{"V", 1.0f, albedo, g}, nullptr}};
+  in.stars = {StarLight{{0, 0, 0}, {power}}};
   in.camera = telescope(pixels, 2.0f);
   in.spp = spp;
   in.max_orders = 1;
@@ -238,8 +239,8 @@ TEST(PathTracer, EquiangularMisAgreesAndHelpsWithAStarInDust) {
   DensityGrid g = noise_grid(12, 1.0f, 0.5f, 71);
   TruthInputs in;
   in.density = &g;
-  in.bands = {TruthBand{"V", 1.0f, 0.8f, 0.6f, nullptr}};
-  in.stars = {TruthStar{{0.05f, 0.1f, -0.02f}, {100.0f}}, TruthStar{{0.0f, 3.0f, 0.0f}, {100.0f}}};
+  in.bands = {TruthBand{{"V", 1.0f, 0.8f, 0.6f}, nullptr}};
+  in.stars = {StarLight{{0.05f, 0.1f, -0.02f}, {100.0f}}, StarLight{{0.0f, 3.0f, 0.0f}, {100.0f}}};
   in.camera = telescope(16, 2.0f);
   in.spp = 64;
   const TruthOutput plain = render_truth_cpu(in);
@@ -277,8 +278,8 @@ TEST(PathTracer, VanDeHulstSlabThroughTheGrid) {
   const float D = 1e6f;
   TruthInputs in;
   in.density = &g;
-  in.bands = {TruthBand{"V", 1.0f, 0.9f, 0.75f, nullptr}};
-  in.stars = {TruthStar{{0, 0, 8 + D}, {float(4 * kPiD * double(D) * D)}}};
+  in.bands = {TruthBand{{"V", 1.0f, 0.9f, 0.75f}, nullptr}};
+  in.stars = {StarLight{{0, 0, 8 + D}, {float(4 * kPiD * double(D) * D)}}};
   in.camera = telescope(4, 1.0f);
   const HostPathScene h = prepare_path_scene(in);
   const int n = 200000;
@@ -324,8 +325,8 @@ TEST(PathTracer, SemiInfiniteIsotropicReflectanceThroughTheGrid) {
   const float D = 1e6f;
   TruthInputs in;
   in.density = &g;
-  in.bands = {TruthBand{"V", 1.0f, 0.8f, 0.0f, nullptr}};
-  in.stars = {TruthStar{{0, 0, 40 + D}, {float(4 * kPiD * double(D) * D)}}};
+  in.bands = {TruthBand{{"V", 1.0f, 0.8f, 0.0f}, nullptr}};
+  in.stars = {StarLight{{0, 0, 40 + D}, {float(4 * kPiD * double(D) * D)}}};
   in.camera = telescope(4, 1.0f);
   const HostPathScene h = prepare_path_scene(in);
   Mean R;
@@ -361,8 +362,8 @@ TEST(PathTracer, AgreesWithTheFastRendererInTheThinLimit) {
   const Image fast = render_cpu(s.inputs, nullptr);
   TruthInputs in;
   in.density = &s.grid;
-  in.bands = {TruthBand{"V", 1.0f, 0.6f, 0.0f, nullptr}};
-  in.stars = {TruthStar{star, {power}}};
+  in.bands = {TruthBand{{"V", 1.0f, 0.6f, 0.0f}, nullptr}};
+  in.stars = {StarLight{star, {power}}};
   in.camera = s.inputs.camera;
   in.spp = 1024;
   in.max_orders = 1;
@@ -387,8 +388,8 @@ TEST(PathTracer, ExactAndRatioTrackedTransmittanceAgree) {
   DensityGrid g = noise_grid(12, 1.0f, 1.0f, 51);
   TruthInputs in;
   in.density = &g;
-  in.bands = {TruthBand{"V", 1.0f, 0.8f, 0.5f, nullptr}};
-  in.stars = {TruthStar{{0.1f, 1.5f, 0.2f}, {100.0f}}};
+  in.bands = {TruthBand{{"V", 1.0f, 0.8f, 0.5f}, nullptr}};
+  in.stars = {StarLight{{0.1f, 1.5f, 0.2f}, {100.0f}}};
   in.camera = telescope(16, 2.0f);
   in.spp = 64;
   const TruthOutput ratio = render_truth_cpu(in);
@@ -407,8 +408,8 @@ TEST(PathTracer, SameSeedSameImageAndNoNaN) {
   DensityGrid g = noise_grid(10, 1.0f, 2.0f, 41);
   TruthInputs in;
   in.density = &g;
-  in.bands = {TruthBand{"B", 1.3f, 0.7f, 0.8f, nullptr}, TruthBand{"V", 1.0f, 0.99f, -0.5f, nullptr}};
-  in.stars = {TruthStar{{0.05f, 0.02f, 0.01f}, {100.0f, 80.0f}}, TruthStar{{3, 0, 0}, {10.0f, 10.0f}}};
+  in.bands = {TruthBand{{"B", 1.3f, 0.7f, 0.8f}, nullptr}, TruthBand{{"V", 1.0f, 0.99f, -0.5f}, nullptr}};
+  in.stars = {StarLight{{0.05f, 0.02f, 0.01f}, {100.0f, 80.0f}}, StarLight{{3, 0, 0}, {10.0f, 10.0f}}};
   in.camera = telescope(12, 2.2f);
   in.spp = 8;
   const TruthOutput a = render_truth_cpu(in), b = render_truth_cpu(in);
@@ -428,8 +429,8 @@ TEST(PathTracer, CameraInsideTheCloudStaysFinite) {
   DensityGrid g = noise_grid(10, 1.0f, 1.0f, 61);
   TruthInputs in;
   in.density = &g;
-  in.bands = {TruthBand{"V", 1.0f, 0.6f, 0.6f, nullptr}};
-  in.stars = {TruthStar{{0.01f, 0.02f, 0.03f}, {1e4f}}};
+  in.bands = {TruthBand{{"V", 1.0f, 0.6f, 0.6f}, nullptr}};
+  in.stars = {StarLight{{0.01f, 0.02f, 0.03f}, {1e4f}}};
   for (Projection p : {Projection::Perspective, Projection::Fisheye}) {
     CameraSettings cs;
     cs.projection = p;
@@ -454,7 +455,7 @@ TEST(PathTracer, RefusesBadInputs) {
   DensityGrid g = cube(4, 1.0f, 0.1f);
   TruthInputs in;
   in.density = &g;
-  in.bands = {TruthBand{"V", 1.0f, 0.6f, 0.6f, nullptr}};
+  in.bands = {TruthBand{{"V", 1.0f, 0.6f, 0.6f}, nullptr}};
   in.camera = telescope(4, 1.0f);
   in.spp = 1;
   EXPECT_THROW(render_truth_cpu(in), Error);
@@ -462,7 +463,7 @@ TEST(PathTracer, RefusesBadInputs) {
   in.bands[0].g = 1.0f;
   EXPECT_THROW(render_truth_cpu(in), Error);
   in.bands[0].g = 0.0f;
-  in.stars = {TruthStar{{0, 0, 0}, {}}};
+  in.stars = {StarLight{{0, 0, 0}, {}}};
   EXPECT_THROW(render_truth_cpu(in), Error);
   std::vector<float> short_emission(3, 0.0f);
   in.stars.clear();

@@ -7,7 +7,7 @@
 
 #include "core/error.h"
 #include "core/progress.h"
-#include "validation/truth_renderer.h"
+#include "truth/truth_renderer.h"
 
 namespace nebula {
 
@@ -24,12 +24,12 @@ void validate(const TruthInputs& in) {
     if (b.emission && b.emission->size() != voxels)
       throw Error("truth: emission of band " + b.name + " does not match the density grid");
   }
-  for (const TruthStar& s : in.stars)
+  for (const StarLight& s : in.stars)
     if (s.power.size() != in.bands.size()) throw Error("truth: a star lacks band powers");
-  if (in.spp < 2) throw Error("--spp: at least 2 samples per pixel (the variance needs two)");
-  if (in.max_orders < 0) throw Error("--max-orders: must be 0 (all) or positive");
-  if (in.roulette_start < 1) throw Error("truth: roulette_start must be at least 1");
-  if (in.majorant_block < 1 || in.majorant_block > 256) throw Error("--majorant-block: must be 1 to 256 voxels");
+  if (in.spp < 2) throw ParameterError("spp", "at least 2 samples per pixel (the variance needs two)");
+  if (in.max_orders < 0) throw ParameterError("max_orders", "must be 0 (all) or positive");
+  if (in.roulette_start < 1) throw ParameterError("roulette_start", "must be at least 1");
+  if (in.majorant_block < 1 || in.majorant_block > 256) throw ParameterError("majorant_block", "must be 1 to 256 voxels");
   if (in.camera.width < 1 || in.camera.height < 1) throw Error("truth: the camera has no pixels");
 }
 
@@ -37,40 +37,16 @@ HostPathScene prepare_path_scene(const TruthInputs& in) {
   validate(in);
   HostPathScene h;
   h.majorant = build_majorant_grid(*in.density, in.majorant_block);
-  h.stars.resize(in.stars.size());
-  for (size_t k = 0; k < in.stars.size(); ++k) {
-    h.stars[k].position = in.stars[k].position;
-    for (int b = 0; b < kMaxBands; ++b) h.stars[k].power[b] = b < int(in.bands.size()) ? in.stars[k].power[b] : 0.0f;
-  }
-  PathScene& s = h.scene;
-  s.density = in.density->view();
-  s.majorant = h.majorant.view();
-  s.n_bands = static_cast<int>(in.bands.size());
-  for (int b = 0; b < kMaxBands; ++b) {
-    const bool used = b < s.n_bands;
-    s.extinction_ratio[b] = used ? in.bands[b].extinction_ratio : 1.0f;
-    s.albedo[b] = used ? in.bands[b].albedo : 0.0f;
-    s.g[b] = used ? in.bands[b].g : 0.0f;
-    s.emission[b] = used && in.bands[b].emission ? in.bands[b].emission->data() : nullptr;
-  }
-  s.stars = h.stars.data();
-  s.n_stars = static_cast<int>(h.stars.size());
-  s.seed = in.seed;
-  s.max_orders = in.max_orders;
-  s.roulette_start = in.roulette_start;
-  s.exact_transmittance = in.exact_transmittance;
-  s.equiangular = in.equiangular;
+  h.scene = assemble_path_scene(in, h.majorant, h.place);
   return h;
 }
 
 TruthOutput render_truth_cpu(const TruthInputs& in) {
   HostPathScene host = prepare_path_scene(in);
   const PathScene& s = host.scene;
-  std::vector<std::string> names;
-  for (const TruthBand& b : in.bands) names.push_back(b.name);
   TruthOutput out;
-  out.image = Image(in.camera.width, in.camera.height, names);
-  out.variance = Image(in.camera.width, in.camera.height, names);
+  out.image = Image(in.camera.width, in.camera.height, band_names(in.bands));
+  out.variance = Image(in.camera.width, in.camera.height, band_names(in.bands));
   std::atomic<uint64_t> vertices{0}, tentative{0}, capped{0}, rays{0};
   const auto start = std::chrono::steady_clock::now();
   tbb::parallel_for(tbb::blocked_range<int>(0, in.camera.height), [&](const auto& rows) {

@@ -7,33 +7,27 @@
 #include <vector>
 
 #include "core/backend.h"
+#include "core/bands.h"
+#include "core/camera.h"
 #include "core/grid.h"
 #include "core/image.h"
-#include "raycast/camera.h"
-#include "validation/majorant_grid.h"
-#include "validation/path_tracer.h"
+#include "core/placement.h"
+#include "truth/majorant_grid.h"
+#include "truth/path_tracer.h"
 
 namespace nebula {
 
 class Progress;
 
-struct TruthBand {
-  std::string name;
-  float extinction_ratio = 1;  // A_b / A_V
-  float albedo = 0.6f;
-  float g = 0.6f;
+// A band as the path tracer reads it: the dust's albedo and g, and emission.
+struct TruthBand : Band {
   const std::vector<float>* emission = nullptr;  // j per voxel, or null
-};
-
-struct TruthStar {
-  Vec3 position;
-  std::vector<float> power;  // per band, L_sun
 };
 
 struct TruthInputs {
   const DensityGrid* density = nullptr;
   std::vector<TruthBand> bands;
-  std::vector<TruthStar> stars;
+  std::vector<StarLight> stars;
   Camera camera;
   float exposure = 1.0f;
   int spp = 16;            // samples per pixel and band, >= 2
@@ -54,17 +48,52 @@ struct TruthOutput {
   PathCounters counters;
 };
 
-// Throws Error naming the field on inconsistent inputs.
+// Throws ParameterError naming the field of a bad setting (spp, max_orders,
+// majorant_block, ...), Error on inconsistent inputs.
 void validate(const TruthInputs& in);
 TruthOutput render_truth(const TruthInputs& in, Backend backend);
 TruthOutput render_truth_cpu(const TruthInputs& in);
 TruthOutput render_truth_cuda(const TruthInputs& in);
 
-// The host copy of what a path needs (the majorant grid and the stars
-// owned here), for the CPU launch and for tests that call trace_path.
+// A path's kernel scene, assembled once for both backends (core/placement.h)
+// from validated inputs and their majorant grid: the density, majorant and
+// emission arrays and the star views placed on the host as they are, or
+// uploaded for CUDA.
+template <class Place>
+PathScene assemble_path_scene(const TruthInputs& in, const MajorantGrid& majorant, Place& place) {
+  std::vector<TruthStarView> stars(in.stars.size());
+  for (size_t k = 0; k < in.stars.size(); ++k) {
+    stars[k].position = in.stars[k].position;
+    for (int b = 0; b < kMaxBands; ++b) stars[k].power[b] = b < int(in.bands.size()) ? in.stars[k].power[size_t(b)] : 0.0f;
+  }
+  PathScene s;
+  s.density = {in.density->shape, place.place(in.density->tau_v)};
+  s.majorant = majorant.view();
+  s.majorant.max_tau_v = place.place(majorant.max_tau_v);
+  s.majorant.min_tau_v = place.place(majorant.min_tau_v);
+  s.n_bands = static_cast<int>(in.bands.size());
+  for (int b = 0; b < kMaxBands; ++b) {
+    const bool used = b < s.n_bands;
+    s.extinction_ratio[b] = used ? in.bands[size_t(b)].extinction_ratio : 1.0f;
+    s.albedo[b] = used ? in.bands[size_t(b)].albedo : 0.0f;
+    s.g[b] = used ? in.bands[size_t(b)].g : 0.0f;
+    s.emission[b] = used && in.bands[size_t(b)].emission ? place.place(*in.bands[size_t(b)].emission) : nullptr;
+  }
+  s.stars = place.keep(std::move(stars));
+  s.n_stars = static_cast<int>(in.stars.size());
+  s.seed = in.seed;
+  s.max_orders = in.max_orders;
+  s.roulette_start = in.roulette_start;
+  s.exact_transmittance = in.exact_transmittance;
+  s.equiangular = in.equiangular;
+  return s;
+}
+
+// The host copy of what a path needs, for the CPU launch and for tests that
+// call trace_path: validates, builds the majorant grid and assembles.
 struct HostPathScene {
   MajorantGrid majorant;
-  std::vector<TruthStarView> stars;
+  HostPlacement place;
   PathScene scene;
 };
 HostPathScene prepare_path_scene(const TruthInputs& in);

@@ -1,6 +1,6 @@
-// CUDA launch of the path tracer: uploads the density, majorant grid,
-// emission and stars, then one thread per pixel runs the shared trace_pixel
-// for all its samples.
+// CUDA launch of the path tracer: the path scene is assembled with a device
+// placement (the density, majorant grid, emission and stars uploaded), then
+// one thread per pixel runs the shared trace_pixel for all its samples.
 #include <cuda_runtime.h>
 
 #include <algorithm>
@@ -8,9 +8,10 @@
 #include <vector>
 
 #include "core/cuda_check.h"
-#include "core/device_array.h"
 #include "core/cuda_timer.h"
-#include "validation/truth_renderer.h"
+#include "core/device_array.h"
+#include "core/device_placement.h"
+#include "truth/truth_renderer.h"
 
 namespace nebula {
 namespace {
@@ -38,27 +39,13 @@ __global__ void truth_kernel(PathScene scene, Camera camera, float exposure, int
 }  // namespace
 
 TruthOutput render_truth_cuda(const TruthInputs& in) {
-  HostPathScene host = prepare_path_scene(in);
-  PathScene scene = host.scene;
-  DeviceArray<float> density(in.density->tau_v);
-  DeviceArray<float> max_tau(host.majorant.max_tau_v), min_tau(host.majorant.min_tau_v);
-  scene.density.tau_v = density.get();
-  scene.majorant.max_tau_v = max_tau.get();
-  scene.majorant.min_tau_v = min_tau.get();
-  std::vector<std::unique_ptr<DeviceArray<float>>> emission;
-  for (int b = 0; b < scene.n_bands; ++b)
-    if (in.bands[b].emission) {
-      emission.push_back(std::make_unique<DeviceArray<float>>(*in.bands[b].emission));
-      scene.emission[b] = emission.back()->get();
-    }
-  DeviceArray<TruthStarView> stars(host.stars);
-  scene.stars = stars.get();
-
-  std::vector<std::string> names;
-  for (const TruthBand& b : in.bands) names.push_back(b.name);
+  validate(in);
+  const MajorantGrid majorant = build_majorant_grid(*in.density, in.majorant_block);
+  DevicePlacement device;
+  const PathScene scene = assemble_path_scene(in, majorant, device);
   TruthOutput out;
-  out.image = Image(in.camera.width, in.camera.height, names);
-  out.variance = Image(in.camera.width, in.camera.height, names);
+  out.image = Image(in.camera.width, in.camera.height, band_names(in.bands));
+  out.variance = Image(in.camera.width, in.camera.height, band_names(in.bands));
   DeviceArray<float> image(out.image.pixels.size()), variance(out.variance.pixels.size());
   DeviceArray<unsigned long long> counters(4);
   const dim3 block(16, 8), grid((in.camera.width + 15) / 16, (in.camera.height + 7) / 8);
@@ -66,12 +53,10 @@ TruthOutput render_truth_cuda(const TruthInputs& in) {
   truth_kernel<<<grid, block>>>(scene, in.camera, in.exposure, in.spp, image.get(), variance.get(), counters.get());
   NEBULA_CUDA_CHECK(cudaGetLastError());
   out.seconds = timer.seconds();
-  NEBULA_CUDA_CHECK(cudaMemcpy(out.image.pixels.data(), image.get(), out.image.pixels.size() * sizeof(float),
-                               cudaMemcpyDeviceToHost));
-  NEBULA_CUDA_CHECK(cudaMemcpy(out.variance.pixels.data(), variance.get(),
-                               out.variance.pixels.size() * sizeof(float), cudaMemcpyDeviceToHost));
+  image.download(out.image.pixels.data());
+  variance.download(out.variance.pixels.data());
   unsigned long long c[4] = {};
-  NEBULA_CUDA_CHECK(cudaMemcpy(c, counters.get(), sizeof c, cudaMemcpyDeviceToHost));
+  counters.download(c);
   out.counters.vertices = c[0];
   out.counters.tentative = c[1];
   out.counters.capped = c[2];

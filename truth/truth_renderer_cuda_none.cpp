@@ -1,10 +1,8 @@
-#include "core/error.h"
-#include "validation/truth_renderer.h"
+#include "core/gpu.h"
+#include "truth/truth_renderer.h"
 
 namespace nebula {
 
-TruthOutput render_truth_cuda(const TruthInputs&) {
-  throw Error("--backend cuda: this build has no CUDA backend (configured without a CUDA compiler)");
-}
+TruthOutput render_truth_cuda(const TruthInputs&) { no_cuda_backend(); }
 
 }  // namespace nebula

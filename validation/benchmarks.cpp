@@ -3,16 +3,16 @@
 #include <algorithm>
 #include <cmath>
 
+#include "axial/axial_bake.h"
+#include "axial/axial_renderer.h"
 #include "core/philox.h"
-#include "illumination/axial_bake.h"
 #include "illumination/optical_depth_bake.h"
-#include "raycast/pyramid_render.h"
-#include "raycast/axial_renderer.h"
+#include "montecarlo/table_conversion.h"
+#include "multires/pyramid_render.h"
 #include "raycast/renderer.h"
 #include "scene/density_sources.h"
 #include "tables/scattering_table.h"
-#include "validation/table_conversion.h"
-#include "validation/truth_renderer.h"
+#include "truth/truth_renderer.h"
 
 namespace nebula {
 namespace {
@@ -150,9 +150,9 @@ struct BenchNebula {
     RenderInputs in;
     in.density = &grid;
     const float ratios[3] = {1.2f, 1.0f, 0.85f};
-    for (int b = 0; b < 3; ++b) in.bands.push_back(RenderBand{std::string(1, "BVR"[b]), ratios[b], 0.6f, &table, nullptr});
+    for (int b = 0; b < 3; ++b) in.bands.push_back(RenderBand{{std::string(1, "BVR"[b]), ratios[b], 0.6f}, &table, nullptr});
     for (size_t k = 0; k < positions.size(); ++k)
-      in.stars.push_back(RenderStar{positions[k], {1e3f, 1e3f, 1e3f}, &bake.tau_v[k]});
+      in.stars.push_back(BakedStar{{positions[k], {1e3f, 1e3f, 1e3f}}, &bake.tau_v[k]});
     in.camera = make_camera(camera);
     return in;
   }
@@ -223,8 +223,8 @@ TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int 
   TruthInputs in;
   in.density = &nebula.grid;
   const float ratios[3] = {1.2f, 1.0f, 0.85f};
-  for (int b = 0; b < 3; ++b) in.bands.push_back(TruthBand{std::string(1, "BVR"[b]), ratios[b], 0.6f, 0.6f, nullptr});
-  in.stars = {TruthStar{nebula.centre, {1e3f, 1e3f, 1e3f}}};
+  for (int b = 0; b < 3; ++b) in.bands.push_back(TruthBand{{std::string(1, "BVR"[b]), ratios[b], 0.6f, 0.6f}, nullptr});
+  in.stars = {StarLight{nebula.centre, {1e3f, 1e3f, 1e3f}}};
   in.camera = make_camera(nebula.camera);
   in.spp = spp;
   in.exact_transmittance = exact_transmittance;
@@ -275,10 +275,10 @@ void bench_axial(Backend backend, int map_size, int width, int height, int repea
     in.map = &map;
     const float ratios[3] = {1.2f, 1.0f, 0.85f};
     for (int b = 0; b < 3; ++b)
-      in.bands.push_back(AxialRenderBand{std::string(1, "BVR"[b]), ratios[b], star ? 0.6f : 0.0f, star ? &table : nullptr});
+      in.bands.push_back(AxialRenderBand{{std::string(1, "BVR"[b]), ratios[b], star ? 0.6f : 0.0f}, star ? &table : nullptr});
     if (star) {
       depth = bake_axial_star_depths(map.nx, map.nr, map.texel, map.tau_v, {0.5f}, backend).tau_v;
-      in.stars.push_back(AxialRenderStar{centre, {1.0f, 1.0f, 1.0f}, &depth[0]});
+      in.stars.push_back(BakedStar{{centre, {1.0f, 1.0f, 1.0f}}, &depth[0]});
     }
     in.step = step_texels * texel;
     in.step_aside = step_aside;

@@ -7,7 +7,7 @@
 
 #include "core/backend.h"
 #include "montecarlo/tabulate.h"
-#include "raycast/pyramid_render.h"
+#include "multires/pyramid_render.h"
 
 namespace nebula {
 
@@ -103,7 +103,7 @@ TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int 
 
 #include <functional>
 
-#include "raycast/axial_march.h"
+#include "axial/axial_march.h"
 
 namespace nebula {
 

@@ -38,7 +38,7 @@ Comparison compare_images(const Image& a, const Image& b, const Image* var_a, co
   check_same(a, b, a_name, b_name);
   if (var_a) check_same(*var_a, a, a_name + " (variance)", a_name);
   if (var_b) check_same(*var_b, b, b_name + " (variance)", b_name);
-  if (!(signal_fraction >= 0 && signal_fraction < 1)) throw Error("--signal: must be in [0, 1)");
+  if (!(signal_fraction >= 0 && signal_fraction < 1)) throw ParameterError("signal_fraction", "must be in [0, 1)");
   Comparison out;
   out.signal_fraction = signal_fraction;
   const size_t n = a.plane_size();
@@ -145,13 +145,6 @@ Image difference_picture(const Image& a, const Image& b, double signal_fraction,
       }
   }
   return out;
-}
-
-std::string variance_path(const std::string& path) {
-  const size_t slash = path.find_last_of('/');
-  const size_t dot = path.rfind('.');
-  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return path + ".var";
-  return path.substr(0, dot) + ".var" + path.substr(dot);
 }
 
 }  // namespace nebula

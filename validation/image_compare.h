@@ -47,7 +47,4 @@ std::string to_json(const Comparison& c);
 // so that write_image writes it as an sRGB PNG with exposure 1.
 Image difference_picture(const Image& a, const Image& b, double signal_fraction, std::vector<double>* ranges);
 
-// Where the variance of an image lives: "out.h5" -> "out.var.h5".
-std::string variance_path(const std::string& image_path);
-
 }  // namespace nebula

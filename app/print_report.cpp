@@ -1,0 +1,88 @@
+#include "app/print_report.h"
+
+#include <cstdio>
+
+namespace nebula::app {
+namespace {
+
+std::string joined(const std::vector<std::string>& items) {
+  std::string out;
+  for (const std::string& s : items) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+void print_headline(const RunReport& r) {
+  const char* verb = r.renderer == "truth" ? "truth" : "rendered";
+  std::printf("%s %s: %dx%d %s, %zu band(s), %zu star(s), ", verb, r.scene.c_str(), r.width, r.height,
+              r.camera.c_str(), r.bands.size(), r.stars);
+  if (r.axial) {
+    const AxialMapReport& a = *r.axial;
+    std::printf("axial map %dx%d, skip %s%s, step %g texel", a.nx, a.nr, a.skip.c_str(),
+                a.skip_used != a.skip ? " (ran naive: the map has no empty texel)" : "", a.step_texels);
+  } else {
+    std::printf("grid %dx%dx%d, ", r.grid.nx, r.grid.ny, r.grid.nz);
+    if (r.truth)
+      std::printf("%d spp", r.truth->spp);
+    else
+      std::printf("%s traversal", r.mode == "exact" ? "exact" : "smooth");
+  }
+  std::printf(", %s\n", to_string(r.backend));
+}
+
+void print_computed(const RunReport& r) {
+  std::printf("computed, and why:\n");
+  for (const BandReport& b : r.bands)
+    std::printf("  band %s: A/A_V %.4f (%s law, R_V %g, Bessell passband), albedo %g, g %g%s\n", b.name.c_str(),
+                b.extinction_ratio, to_string(r.law), r.R_V, b.albedo, b.g,
+                b.scatters ? "" : (r.truth ? " (no scattering)" : " (no scattering: no table)"));
+  if (r.axial) {
+    const AxialMapReport& a = *r.axial;
+    std::printf("  map: %s, %d x %d texels of %g pc, %zu emission plane(s), height-map max %d, %g s\n",
+                a.source.c_str(), a.nx, a.nr, a.texel_pc, a.emission_planes, a.height_max, a.build_seconds);
+  }
+  for (const TableReport& t : r.tables)
+    std::printf("  table a=%g g=%g for %s: %s %s (%.3g s)\n", t.albedo, t.g, joined(t.bands).c_str(),
+                to_string(t.origin), t.path.c_str(), t.seconds);
+  if (r.truth) return;
+  if (r.bake.done)
+    std::printf("  bake: %zu star(s)%s x %llu %s, %g s\n", r.bake.stars, r.axial ? " on the axis" : "",
+                (unsigned long long)r.bake.cells, r.axial ? "texels" : "voxels", r.bake.seconds);
+  else
+    std::printf("  bake: skipped (no scattering band or no star)\n");
+  if (r.axial) {
+    std::printf("  memory: map and skip structures %.3g MiB, with depths and tables %.3g MiB (%s)\n",
+                r.axial->map_bytes / 1048576.0, r.axial->render_bytes / 1048576.0,
+                r.backend == Backend::Cuda ? "on the GPU" : "host");
+    return;
+  }
+  std::printf("  emission: %s\n", r.emission ? "per band grid" : "none in the scene");
+  if (r.pyramid.size() <= 1) std::printf("  pyramid levels: none\n");
+  for (size_t j = 1; j < r.pyramid.size(); ++j) {
+    const PyramidLevelReport& p = r.pyramid[j];
+    std::printf("  pyramid level %d: grid %dx%dx%d (voxel %g pc), image %dx%d; build %.3f s, bake %.3f s, render %.3f s, "
+                "%llu lookups beyond tau_max\n",
+                p.level, p.shape.nx, p.shape.ny, p.shape.nz, p.shape.voxel, p.width, p.height, p.pyramid_seconds,
+                p.bake_seconds, p.render_seconds, (unsigned long long)p.table_clamps);
+  }
+}
+
+}  // namespace
+
+void print_report(const RunReport& r) {
+  print_headline(r);
+  print_computed(r);
+  if (r.truth) {
+    const TruthReport& t = *r.truth;
+    const double s = r.render_seconds;
+    std::printf("  paths %llu, collisions (path vertices) %llu, tentative collisions %llu, capped %llu\n",
+                (unsigned long long)t.paths, (unsigned long long)t.counters.vertices,
+                (unsigned long long)t.counters.tentative, (unsigned long long)t.counters.capped);
+    std::printf("  tracing %.3f s: %.3g vertices/s, %.3g paths/s, %.3g spp/s at this size; total %.2f s\n", s,
+                t.counters.vertices / s, t.paths / s, t.spp / s, r.total_seconds);
+    return;
+  }
+  std::printf("render: %.3f s marching, %llu table lookups beyond tau_max (clamped); total %.2f s\n", r.render_seconds,
+              (unsigned long long)r.table_clamps, r.total_seconds);
+}
+
+}  // namespace nebula::app

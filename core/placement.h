@@ -1,0 +1,38 @@
+#pragma once
+// Where a renderer's inputs live while its kernel reads them. Each renderer
+// assembles its kernel scene (a struct of pointers, passed by value) in one
+// function templated on the placement: HostPlacement hands back the host
+// arrays themselves (the CPU path), DevicePlacement (core/device_placement.h,
+// .cu files only) uploads copies it owns (the CUDA path). The two paths then
+// differ only in where the arrays live, never in how the scene is put together.
+#include <cstddef>
+#include <memory>
+#include <utility>
+#include <vector>
+
+namespace nebula {
+
+class HostPlacement {
+ public:
+  // The caller's array itself (it must outlive the render).
+  template <class T>
+  const T* place(const std::vector<T>& v) {
+    bytes_ += v.size() * sizeof(T);
+    return v.data();
+  }
+  // An array made while assembling (per-star views, say), kept alive here.
+  template <class T>
+  const T* keep(std::vector<T> v) {
+    auto held = std::make_shared<std::vector<T>>(std::move(v));
+    held_.push_back(held);
+    return held->data();
+  }
+  // Bytes of the arrays given to place(): what the kernel reads.
+  size_t bytes() const { return bytes_; }
+
+ private:
+  std::vector<std::shared_ptr<const void>> held_;
+  size_t bytes_ = 0;
+};
+
+}  // namespace nebula

@@ -1,0 +1,48 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/gpu.h"
+#include "core/philox.h"
+#include "multires/pyramid_render.h"
+#include "raycast/test_scenes.h"
+
+namespace nebula {
+namespace {
+
+// The pyramid on the GPU: bakes, renders and combines every level there
+// (the combination's per-pixel steps are multires/pyramid_pixels.h on both). Levels add up, so the tolerance is the exact
+// mode's 1e-4 of the peak per level.
+TEST(PyramidGpu, AgreesWithTheCpu) {
+  std::string why;
+  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  testing::OneStarScene s;
+  s.grid = testing::cube(40, 1.0f);  // 40 -> 20 -> 10 -> 5: odd at the last level
+  for (size_t c = 0; c < s.grid.tau_v.size(); ++c)
+    s.grid.tau_v[c] = 0.3f * philox_uniform4(5, 0, uint32_t(c), 0, 0).u0;
+  s.table = testing::thin_table(0.6, 72, 10.0);
+  CameraSettings cs;
+  cs.position = {0.3f, -2.5f, -2.0f};
+  cs.look_at = {0, 0, 0};
+  cs.up = {0, 0, 1};
+  cs.fov_deg = 50;
+  cs.width = 90;
+  cs.height = 61;
+  s.finish({0.1f, 0.2f, -0.1f}, 100.0f, 0.6f, make_camera(cs));
+  const PyramidResult cpu = render_pyramid(s.inputs, 3, Backend::Cpu);
+  const PyramidResult gpu = render_pyramid(s.inputs, 3, Backend::Cuda, true);
+  ASSERT_EQ(gpu.levels.size(), 4u);
+  EXPECT_EQ(gpu.levels[3].width, cpu.levels[3].width);
+  double peak = 0, worst = 0;
+  for (size_t i = 0; i < cpu.image.pixels.size(); ++i) {
+    peak = std::max(peak, double(cpu.image.pixels[i]));
+    worst = std::max(worst, double(std::fabs(cpu.image.pixels[i] - gpu.image.pixels[i])));
+  }
+  std::printf("pyramid, 3 levels: largest CPU-GPU difference %.3g of the peak\n", worst / peak);
+  EXPECT_GT(peak, 0.0);
+  EXPECT_LT(worst, 4e-4 * peak);
+  for (int j = 0; j <= 3; ++j) EXPECT_EQ(cpu.report[j].table_clamps, gpu.report[j].table_clamps);
+}
+
+}  // namespace
+}  // namespace nebula

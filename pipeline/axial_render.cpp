@@ -1,0 +1,112 @@
+// The fast renderer on an axial map: the map, bands, tables (only with stars
+// to scatter), one bake per star on the axis, then the frame (axial/).
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+#include "axial/axial_bake.h"
+#include "axial/axial_renderer.h"
+#include "core/error.h"
+#include "core/progress.h"
+#include "pipeline/axial_map_source.h"
+#include "pipeline/render_scene.h"
+#include "pipeline/run_setup.h"
+
+namespace nebula {
+
+using namespace pipeline_detail;
+
+namespace {
+
+RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
+  if (o.smooth_step != 0) throw ParameterError("smooth_step", "not for axial maps (their step is axial.step_texels)");
+  validate_scene(scene);
+  const AxialSpec& spec = *scene.axial;
+  const AxialSkip skip = parse_axial_skip(spec.skip, scene.path + ": axial.skip");
+  const Camera camera = make_camera(scene.camera);
+  const size_t n_bands = scene.bands.size();
+
+  const auto t_map = std::chrono::steady_clock::now();
+  const AxialMap map = build_axial_map(scene);
+  AxialMapReport map_report;
+  map_report.source = spec.source + " " + (spec.source == "synthetic" ? spec.synthetic : spec.path);
+  map_report.nx = map.nx;
+  map_report.nr = map.nr;
+  map_report.texel_pc = map.texel;
+  map_report.emission_planes = map.emission.size();
+  map_report.height_max = map.global_max;
+  map_report.build_seconds = seconds_since(t_map);
+  map_report.skip = to_string(skip);
+  map_report.step_texels = spec.step_texels;
+  map_report.map_bytes = map.bytes();
+  const SceneBands sb = scene_bands(scene);
+
+  // Tables only when there are stars to scatter: emission alone needs none.
+  BandTables tables;
+  tables.per_band.assign(n_bands, nullptr);
+  if (!scene.stars.empty()) tables = resolve_tables(scene, {o.backend, o.table_photons, o.progress});
+  std::vector<bool> scatters(n_bands);
+  bool any = false;
+  for (size_t b = 0; b < n_bands; ++b) {
+    scatters[b] = tables.per_band[b] != nullptr;
+    any = any || scatters[b];
+  }
+
+  RenderOutput out;
+  RunReport& report = out.report;
+  report = begin_report(scene, sb, "axial", o.backend, scatters);
+  report.mode = std::string("axial ") + to_string(skip) + " step " + to_text(spec.step_texels) + " texel";
+  report.tables = tables.report;
+
+  // Stars on the axis: one 2D bake each.
+  std::vector<float> star_x;
+  for (const SceneStar& s : scene.stars) star_x.push_back(dot(s.position - map.origin, map.axis));
+  BakeResult bake;
+  if (any) {
+    const auto t0 = std::chrono::steady_clock::now();
+    bake = bake_axial_star_depths(map.nx, map.nr, map.texel, map.tau_v, star_x, o.backend);
+    report.bake = {true, star_x.size(), map.count(), seconds_since(t0)};
+  }
+
+  AxialRenderInputs in;
+  in.map = &map;
+  for (size_t b = 0; b < n_bands; ++b) {
+    Band band = sb.bands[b];
+    if (!scatters[b]) band.albedo = 0.0f;
+    in.bands.push_back(AxialRenderBand{band, tables.per_band[b].get()});
+  }
+  if (any)
+    for (size_t k = 0; k < star_x.size(); ++k) in.stars.push_back(BakedStar{sb.stars[k], &bake.tau_v[k]});
+  in.camera = camera;
+  in.exposure = static_cast<float>(scene.camera.exposure);
+  in.step = static_cast<float>(spec.step_texels * map.texel);
+  in.skip = skip;
+  AxialRenderStats stats;
+  std::unique_ptr<Progress> bar;
+  if (o.progress && o.backend == Backend::Cpu) bar = std::make_unique<Progress>("render", uint64_t(camera.height));
+  in.progress = bar.get();
+  out.image = render_axial(in, o.backend, &stats);
+  if (bar) bar->finish();
+  for (float v : out.image.pixels)
+    if (!std::isfinite(v)) throw Error("axial render: a non-finite pixel (a bug: please report the scene)");
+
+  map_report.skip_used = to_string(stats.skip_used);
+  map_report.render_bytes = stats.device_bytes;
+  report.axial = map_report;
+  report.render_seconds = stats.seconds;
+  report.table_clamps = stats.table_clamps;
+  out.metadata = scene_metadata(scene, sb, scene.camera, report.mode);
+  return out;
+}
+
+}  // namespace
+
+RenderOutput render_scene(const Scene& scene, const RenderOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  RenderOutput out =
+      scene.axial ? render_axial_scene(scene, options) : render_prepared(prepare_grid(scene, options), scene.camera);
+  out.report.total_seconds = seconds_since(start);
+  return out;
+}
+
+}  // namespace nebula

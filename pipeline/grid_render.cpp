@@ -1,0 +1,111 @@
+// The fast renderer on a 3D grid: bands, tables, one bake per star, the
+// pyramid's coarse levels, then the frame (raycast/, multires/).
+#include <chrono>
+#include <memory>
+#include <string>
+
+#include "core/error.h"
+#include "core/progress.h"
+#include "multires/volume_pyramid.h"
+#include "pipeline/render_scene.h"
+#include "pipeline/run_setup.h"
+
+namespace nebula {
+
+using namespace pipeline_detail;
+
+namespace {
+
+std::string mode_of(const RenderOptions& o) {
+  return o.smooth_step > 0 ? "smooth step " + to_text(o.smooth_step) + " voxel" : "exact";
+}
+
+}  // namespace
+
+PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o) {
+  if (scene.axial) throw Error(scene.path + ": axial: an axial scene has no 3D grid (render it with render_scene)");
+  validate_scene(scene);
+  const GridShape& shape = scene.density.shape;
+  const int most_levels = max_pyramid_levels(shape);
+  if (scene.pyramid_levels > most_levels)
+    throw ParameterError("render.levels", std::to_string(scene.pyramid_levels) + " exceeds the " +
+                                              std::to_string(most_levels) + " a grid of " + std::to_string(shape.nx) +
+                                              "x" + std::to_string(shape.ny) + "x" + std::to_string(shape.nz) +
+                                              " allows (the coarsest level keeps 2 voxels)");
+  if (!(o.smooth_step == 0 || o.smooth_step >= 1e-3f))
+    throw ParameterError("smooth_step", "step in voxels, at least 1e-3 (0: exact)");
+
+  PreparedGrid p;
+  p.scene = &scene;
+  p.options = o;
+  p.bands = scene_bands(scene);
+  p.tables = resolve_tables(scene, {o.backend, o.table_photons, o.progress});
+  const size_t n_bands = scene.bands.size();
+  std::vector<bool> scatters(n_bands);
+  bool any = false;
+  for (size_t b = 0; b < n_bands; ++b) {
+    scatters[b] = p.tables.per_band[b] != nullptr;
+    any = any || scatters[b];
+  }
+  p.report = begin_report(scene, p.bands, "grid", o.backend, scatters);
+  p.report.mode = mode_of(o);
+  p.report.tables = p.tables.report;
+
+  // Stars: one V-band depth bake each, when something scatters their light.
+  std::vector<Vec3> positions;
+  for (const StarLight& s : p.bands.stars) positions.push_back(s.position);
+  if (any && !positions.empty()) {
+    const auto t0 = std::chrono::steady_clock::now();
+    std::unique_ptr<Progress> bar;
+    if (o.progress && o.backend == Backend::Cpu)
+      bar = std::make_unique<Progress>("bake", uint64_t(positions.size()) * shape.ny * shape.nz);
+    p.bake = bake_star_depths(scene.density, positions, o.backend, bar.get());
+    if (bar) bar->finish();
+    p.report.bake = {true, positions.size(), shape.count(), seconds_since(t0)};
+  }
+
+  RenderInputs& in = p.inputs;
+  in.density = &scene.density;
+  for (size_t b = 0; b < n_bands; ++b) {
+    Band band = p.bands.bands[b];
+    if (!scatters[b]) band.albedo = 0.0f;
+    in.bands.push_back(RenderBand{band, p.tables.per_band[b].get(), scene.emission.empty() ? nullptr : &scene.emission[b]});
+  }
+  if (any)
+    for (size_t k = 0; k < positions.size(); ++k) in.stars.push_back(BakedStar{p.bands.stars[k], &p.bake.tau_v[k]});
+  in.mode = MarchMode{o.smooth_step, true};
+  p.pyramid = prepare_pyramid(in, scene.pyramid_levels, o.backend);
+  return p;
+}
+
+RenderOutput render_prepared(const PreparedGrid& p, const CameraSettings& settings) {
+  const Scene& scene = *p.scene;
+  const Camera camera = make_camera(settings);
+  RenderInputs in = p.inputs;
+  in.camera = camera;
+  in.exposure = static_cast<float>(settings.exposure);
+  std::unique_ptr<Progress> bar;
+  if (p.options.progress && p.options.backend == Backend::Cpu)
+    bar = std::make_unique<Progress>("render", uint64_t(camera.height));
+  in.progress = bar.get();
+  const PyramidResult pyramid = render_pyramid(in, p.pyramid, p.options.backend);
+  if (bar) bar->finish();
+
+  RenderOutput out;
+  out.image = pyramid.image;
+  out.report = p.report;
+  out.report.camera = to_string(settings.projection);
+  out.report.width = camera.width;
+  out.report.height = camera.height;
+  out.report.pyramid = pyramid.report;
+  for (const PyramidLevelReport& r : pyramid.report) {
+    out.report.render_seconds += r.render_seconds;
+    out.report.table_clamps += r.table_clamps;
+  }
+  draw_scene_stars(scene, p.bands, camera, settings.exposure, out.image);
+  out.metadata = scene_metadata(scene, p.bands, settings, p.report.mode);
+  out.metadata.entries.push_back({"pyramid_levels", std::to_string(scene.pyramid_levels)});
+  return out;
+}
+
+}  // namespace nebula

@@ -1,0 +1,81 @@
+#pragma once
+// The render pipeline (DESIGN.md section 2): scene -> bands (extinction
+// ratios, star band powers) -> tables (read, cached or generated) -> bakes ->
+// render (3D grid with its pyramid levels, axial map, or the ground truth) ->
+// image, its metadata and the run report. The one entry point the command
+// line, the tests and any other front end call; it prints nothing (progress
+// bars aside) and names scene keys or option fields in its errors
+// (ParameterError), never command-line options.
+#include <cstdint>
+#include <vector>
+
+#include "core/backend.h"
+#include "core/image.h"
+#include "illumination/optical_depth_bake.h"
+#include "imageio/image_output.h"
+#include "multires/pyramid_render.h"
+#include "pipeline/run_report.h"
+#include "pipeline/scene_bands.h"
+#include "pipeline/table_source.h"
+#include "raycast/renderer.h"
+#include "scene/scene.h"
+
+namespace nebula {
+
+struct RenderOptions {
+  Backend backend = Backend::Cpu;
+  uint64_t table_photons = 30000;  // photons per row of tables generated on first use
+  float smooth_step = 0;           // "smooth_step": voxels; 0 is the exact traversal (3D grids only)
+  bool progress = false;           // progress bars on stderr for CPU work
+};
+
+struct RenderOutput {
+  Image image;
+  ImageMetadata metadata;
+  RunReport report;
+};
+
+// The fast renderer on a scene: its 3D grid with render.levels pyramid levels,
+// or its axial map. Validates the scene first. Errors: Error naming the scene
+// file and key, or ParameterError for "render.levels" (more levels than the
+// grid allows) and "smooth_step".
+RenderOutput render_scene(const Scene& scene, const RenderOptions& options);
+
+// The view-independent part of a grid render (bands, tables, star bakes, the
+// pyramid's coarse levels): a new camera re-renders from it with none of that
+// work done again. `scene` must outlive it.
+struct PreparedGrid {
+  const Scene* scene = nullptr;
+  RenderOptions options;
+  SceneBands bands;
+  BandTables tables;
+  BakeResult bake;
+  PreparedPyramid pyramid;
+  RenderInputs inputs;  // everything but the camera and exposure
+  RunReport report;     // the work so far
+};
+PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& options);
+RenderOutput render_prepared(const PreparedGrid& prepared, const CameraSettings& camera);
+
+struct TruthOptions {
+  Backend backend = Backend::Cpu;
+  int spp = 16;                      // "spp": samples per pixel and band, >= 2
+  uint64_t seed = 1;
+  int max_orders = 0;                // "max_orders": 0 keeps every order (the truth)
+  int majorant_block = 4;            // "majorant_block": voxels per block edge
+  bool exact_transmittance = false;  // next-event transmittance by the exact voxel sum
+  bool equiangular = false;          // equiangular next-event samples too (MIS)
+  bool progress = false;
+};
+
+struct TruthRenderOutput {
+  Image image, variance;  // the mean per pixel and band, and the variance of that mean
+  ImageMetadata metadata, variance_metadata;
+  RunReport report;
+};
+
+// The ground-truth path tracer (truth/) on exactly the scene render_scene
+// sees: the same bands, stars, emission and camera; drawn stars the same way.
+TruthRenderOutput truth_scene(const Scene& scene, const TruthOptions& options);
+
+}  // namespace nebula

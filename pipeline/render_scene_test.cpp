@@ -1,0 +1,170 @@
+// The pipeline end to end: what it renders is exactly the renderers' image on
+// inputs assembled by hand from the same pieces, its errors name the scene key
+// or option field, and its report says what it computed.
+#include "pipeline/render_scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+
+#include "montecarlo/table_conversion.h"
+#include "scene/scene_file.h"
+#include "scene/test_files.h"
+#include "tables/table_file.h"
+
+namespace nebula {
+namespace {
+
+class RenderScene : public testing::TempDirTest {
+ protected:
+  void SetUp() override { setenv("NEBULA_CACHE_DIR", path("cache").c_str(), 1); }
+  Scene scene(const std::string& extra = "", const std::string& dust = "") {
+    return load_scene(write_text("scene.toml", "[density]\nprocedural = { n = 16, size_pc = 2.0 }\n[dust]\n" + dust +
+                                                   "\n[[stars]]\nluminosity_lsun = 2e5\nclass = \"O5V\"\n"
+                                                   "[camera]\nposition = [1, -2.5, 1]\nlook_at = [1, 1, 1]\n"
+                                                   "width = 20\nheight = 16\nexposure = 0.02\n" +
+                                                   extra));
+  }
+  RenderOptions options() const {
+    RenderOptions o;
+    o.table_photons = 1000;
+    return o;
+  }
+};
+
+bool same_plane(const Image& a, const Image& b, int band) {
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x)
+      if (a.at(band, x, y) != b.at(band, x, y)) return false;
+  return true;
+}
+
+TEST_F(RenderScene, IsTheRenderersImageOnItsInputs) {
+  const Scene s = scene();
+  const RenderOutput out = render_scene(s, options());
+  // The same render assembled by hand from the pipeline's pieces.
+  const SceneBands sb = scene_bands(s);
+  const BandTables tables = resolve_tables(s, {Backend::Cpu, 1000, false});
+  const BakeResult bake = bake_star_depths_cpu(s.density, {s.stars[0].position});
+  RenderInputs in;
+  in.density = &s.density;
+  for (size_t b = 0; b < 3; ++b) in.bands.push_back(RenderBand{sb.bands[b], tables.per_band[b].get(), nullptr});
+  in.stars.push_back(BakedStar{sb.stars[0], &bake.tau_v[0]});
+  in.camera = make_camera(s.camera);
+  in.exposure = 0.02f;
+  const Image expected = render_cpu(in, nullptr);
+  ASSERT_EQ(out.image.pixels.size(), expected.pixels.size());
+  for (int b = 0; b < 3; ++b) EXPECT_TRUE(same_plane(out.image, expected, b)) << "band " << b;
+  float peak = 0;
+  for (float v : out.image.pixels) peak = std::max(peak, v);
+  EXPECT_GT(peak, 0.0f);
+
+  const RunReport& r = out.report;
+  EXPECT_EQ(r.renderer, "grid");
+  EXPECT_EQ(r.mode, "exact");
+  EXPECT_EQ(r.width, 20);
+  EXPECT_EQ(r.height, 16);
+  ASSERT_EQ(r.bands.size(), 3u);
+  for (const BandReport& b : r.bands) EXPECT_TRUE(b.scatters) << b.name;
+  ASSERT_EQ(r.tables.size(), 1u);
+  EXPECT_EQ(r.tables[0].bands, (std::vector<std::string>{"B", "V", "R"}));
+  EXPECT_TRUE(r.bake.done);
+  EXPECT_EQ(r.bake.stars, 1u);
+  EXPECT_EQ(r.bake.cells, s.density.shape.count());
+  EXPECT_EQ(r.pyramid.size(), 1u);
+  EXPECT_GE(r.total_seconds, r.render_seconds);
+  bool has_mode = false;
+  for (const auto& [key, value] : out.metadata.entries) has_mode = has_mode || (key == "mode" && value == "exact");
+  EXPECT_TRUE(has_mode);
+}
+
+// A table named for one band changes that band's plane and no other.
+TEST_F(RenderScene, ABandsTableFileChangesThatBandOnly) {
+  TabulateParams p;
+  p.albedo = 0.7;
+  p.g = 0.5;
+  p.tau_bins = 101;
+  p.binning = AngularBinning::UniformTheta;
+  p.photons_per_row = 2000;
+  p.seed = 7;  // not the cache's table
+  write_table(to_table(tabulate(p, Backend::Cpu)), path("t07.h5"), true);
+  const std::string dust = "albedo = { B = 0.6, V = 0.7, R = 0.6 }\ng = { B = 0.6, V = 0.5, R = 0.6 }\n";
+  const Scene with_file = scene("", dust + "tables = { V = \"t07.h5\" }");
+  const RenderOutput a = render_scene(with_file, options());
+  const Scene without = scene("", dust);
+  const RenderOutput b = render_scene(without, options());
+  EXPECT_TRUE(same_plane(a.image, b.image, 0));
+  EXPECT_FALSE(same_plane(a.image, b.image, 1));
+  EXPECT_TRUE(same_plane(a.image, b.image, 2));
+  ASSERT_EQ(a.report.tables.size(), 2u);
+  EXPECT_EQ(a.report.tables[1].origin, TableOrigin::File);
+  EXPECT_EQ(a.report.tables[1].bands, (std::vector<std::string>{"V"}));
+}
+
+TEST_F(RenderScene, ErrorsNameTheKeyOrTheField) {
+  Scene s = scene();
+  s.pyramid_levels = 9;  // a 16^3 grid allows 3
+  try {
+    render_scene(s, options());
+    ADD_FAILURE() << "9 levels accepted";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.parameter(), "render.levels");
+    EXPECT_NE(std::string(e.what()).find("9 exceeds the 3"), std::string::npos) << e.what();
+  }
+  s.pyramid_levels = 0;
+  RenderOptions o = options();
+  o.smooth_step = 1e-4f;
+  try {
+    render_scene(s, o);
+    ADD_FAILURE() << "a smooth step of 1e-4 accepted";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.parameter(), "smooth_step");
+  }
+  TruthOptions t;
+  t.spp = 1;
+  try {
+    truth_scene(s, t);
+    ADD_FAILURE() << "1 spp accepted";
+  } catch (const ParameterError& e) {
+    EXPECT_EQ(e.parameter(), "spp");
+  }
+}
+
+TEST_F(RenderScene, PyramidLevelsAreReported) {
+  const Scene s = scene("[render]\nlevels = 2\n");
+  const RenderOutput out = render_scene(s, options());
+  ASSERT_EQ(out.report.pyramid.size(), 3u);
+  EXPECT_EQ(out.report.pyramid[2].shape.nx, 4);
+  EXPECT_EQ(out.report.pyramid[2].width, 5);
+}
+
+TEST_F(RenderScene, AxialMapsAndTheTruthRunThroughTheSamePipeline) {
+  const Scene axial = load_scene(write_text(
+      "axial.toml",
+      "bands = [\"B\", \"V\"]\n[axial]\nsynthetic = \"shells\"\nnx = 32\nnr = 16\nemission_scale = 1.0\n"
+      "[[stars]]\nposition = [0.0, 0.0, 1.0]\nluminosity_lsun = 10\nclass = \"B0V\"\n"
+      "[camera]\nposition = [4.0, 0.0, 1.0]\nlook_at = [0.0, 0.0, 1.0]\nwidth = 12\nheight = 12\n"));
+  const RenderOutput a = render_scene(axial, options());
+  ASSERT_TRUE(a.report.axial.has_value());
+  EXPECT_EQ(a.report.renderer, "axial");
+  EXPECT_EQ(a.report.axial->nx, 32);
+  EXPECT_EQ(a.report.axial->skip, "distance");
+  EXPECT_EQ(a.report.tables.size(), 1u);
+  EXPECT_TRUE(a.report.bake.done);
+  EXPECT_EQ(a.report.bake.cells, 32u * 16u);
+  for (float v : a.image.pixels) EXPECT_TRUE(std::isfinite(v));
+
+  TruthOptions t;
+  t.spp = 4;
+  const TruthRenderOutput truth = truth_scene(scene(), t);
+  EXPECT_EQ(truth.image.width, 20);
+  EXPECT_EQ(truth.variance.pixels.size(), truth.image.pixels.size());
+  ASSERT_TRUE(truth.report.truth.has_value());
+  EXPECT_EQ(truth.report.truth->paths, 20u * 16u * 4u * 3u);
+  EXPECT_EQ(truth.variance_metadata.units, "(L_sun pc^-2 sr^-1 x exposure)^2, variance of the pixel mean");
+  EXPECT_THROW(truth_scene(axial, t), Error);
+}
+
+}  // namespace
+}  // namespace nebula

@@ -1,0 +1,90 @@
+#pragma once
+// What a run computed, and why: data the pipeline fills and front ends show
+// (the command line prints it, app/print_report.cpp; a viewer would draw it).
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/backend.h"
+#include "core/grid.h"
+#include "illumination/extinction.h"
+#include "multires/pyramid_render.h"
+#include "truth/path_tracer.h"
+
+namespace nebula {
+
+struct BandReport {
+  std::string name;
+  double extinction_ratio = 1;  // A_b / A_V
+  double albedo = 0, g = 0;
+  bool scatters = false;        // has a table (albedo > 0, and something to light)
+};
+
+// Where a band's scattering table came from.
+enum class TableOrigin { File, Cache, Generated };
+const char* to_string(TableOrigin origin);  // "read", "cache", "generated"
+
+struct TableReport {
+  double albedo = 0, g = 0;
+  std::vector<std::string> bands;  // the bands that use this table
+  TableOrigin origin = TableOrigin::Cache;
+  std::string path;                // the file read, or the cache entry
+  double seconds = 0;              // reading or generating it
+};
+
+struct BakeReport {
+  bool done = false;    // false: nothing scatters or no star (nothing to bake)
+  size_t stars = 0;
+  uint64_t cells = 0;   // voxels, or texels of an axial map
+  double seconds = 0;
+};
+
+struct AxialMapReport {
+  std::string source;   // synthetic, file or image, with its name
+  int nx = 0, nr = 0;
+  double texel_pc = 0;
+  size_t emission_planes = 0;
+  int height_max = 0;   // the height map's global maximum
+  double build_seconds = 0;
+  std::string skip, skip_used;  // requested and run (naive when the map has no empty texel)
+  double step_texels = 0;
+  size_t map_bytes = 0;     // the map and its skip structures
+  size_t render_bytes = 0;  // everything the march reads (with depths and tables)
+};
+
+struct TruthReport {
+  int spp = 0;
+  uint64_t seed = 0;
+  int max_orders = 0;
+  std::string transmittance;  // "ratio" or "exact"
+  bool equiangular = false;
+  uint64_t paths = 0;
+  PathCounters counters;
+};
+
+struct RunReport {
+  std::string scene;          // the scene's path ("demo" for the built-in one)
+  std::string renderer;       // "grid", "axial" or "truth"
+  std::string mode;           // "exact", "smooth step 0.5 voxel", "axial distance step 0.5 texel", "truth spp 16 ..."
+  Backend backend = Backend::Cpu;
+  std::string camera;         // the projection's name
+  int width = 0, height = 0;
+  GridShape grid;             // grid and truth renders
+  size_t stars = 0;
+  double R_V = 0;
+  ExtinctionLaw law = ExtinctionLaw::CCM89;
+  std::vector<BandReport> bands;
+  std::vector<TableReport> tables;
+  BakeReport bake;
+  bool emission = false;
+  std::vector<PyramidLevelReport> pyramid;  // grid renders: level 0 first
+  std::optional<AxialMapReport> axial;
+  std::optional<TruthReport> truth;
+  double render_seconds = 0;  // marching or tracing only (CUDA events on the GPU)
+  uint64_t table_clamps = 0;  // table lookups beyond tau_max (clamped)
+  double total_seconds = 0;
+};
+
+}  // namespace nebula

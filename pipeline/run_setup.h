@@ -1,0 +1,35 @@
+#pragma once
+// Internal to pipeline/: what every renderer's run derives from the scene the
+// same way (the start of its report, the image metadata, drawn stars).
+#include <chrono>
+#include <string>
+
+#include "core/camera.h"
+#include "core/image.h"
+#include "imageio/image_output.h"
+#include "pipeline/run_report.h"
+#include "pipeline/scene_bands.h"
+#include "scene/scene.h"
+
+namespace nebula::pipeline_detail {
+
+inline double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// The scene, the camera and the bands; `scatters` per band (empty: every band
+// with albedo > 0).
+RunReport begin_report(const Scene& scene, const SceneBands& bands, const std::string& renderer, Backend backend,
+                       const std::vector<bool>& scatters = {});
+
+// Units, per-band albedo, g and extinction ratio, R_V, the camera, the scene
+// file and the render mode.
+ImageMetadata scene_metadata(const Scene& scene, const SceneBands& bands, const CameraSettings& camera,
+                             const std::string& mode);
+
+// The scene's stars drawn as attenuated point sources when output.draw_stars
+// is set (raycast/point_stars.h), for 3D grids.
+void draw_scene_stars(const Scene& scene, const SceneBands& bands, const Camera& camera, double exposure,
+                      Image& image);
+
+}  // namespace nebula::pipeline_detail

@@ -1,0 +1,25 @@
+#pragma once
+// The band physics of a scene (DESIGN.md section 3, "Bands"): every renderer
+// sees a scene's bands and stars through this, computed in one place.
+#include <vector>
+
+#include "core/bands.h"
+#include "illumination/passband.h"
+#include "scene/scene.h"
+
+namespace nebula {
+
+struct SceneBands {
+  std::vector<Passband> filters;  // per scene band, from the filter registry
+  // Per scene band: its name; A_b/A_V, the scene's extinction law (and R_V)
+  // averaged over the filter and normalised to the V filter's, so V is
+  // exactly 1; the scene's albedo and g in that band.
+  std::vector<Band> bands;
+  // Per star: its position and, per band, its bolometric luminosity times the
+  // fraction of its black body the filter passes (L_sun in the band).
+  std::vector<StarLight> stars;
+};
+
+SceneBands scene_bands(const Scene& scene);
+
+}  // namespace nebula

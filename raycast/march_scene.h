@@ -1,0 +1,48 @@
+#pragma once
+// The ray marcher's kernel scene, assembled once from RenderInputs for both
+// backends (core/placement.h): the CPU path places the host arrays
+// themselves, the CUDA path uploads them. Host code only.
+#include <utility>
+#include <vector>
+
+#include "core/bands.h"
+#include "raycast/ray_march.h"
+#include "raycast/renderer.h"
+#include "tables/table_lookup.h"
+
+namespace nebula {
+
+// Kernel views of baked stars (this marcher's and the axial one's): position,
+// the first n_bands band powers and the placed depth map.
+template <class Place>
+const StarView* place_star_views(const std::vector<BakedStar>& stars, int n_bands, Place& place) {
+  std::vector<StarView> views(stars.size());
+  for (size_t k = 0; k < stars.size(); ++k) {
+    views[k].position = stars[k].position;
+    for (int b = 0; b < n_bands; ++b) views[k].power[b] = stars[k].power[size_t(b)];
+    views[k].depth_v = place.place(*stars[k].depth_v);
+  }
+  return place.keep(std::move(views));
+}
+
+// Validates `in`, then builds the scene march_ray reads from placed arrays.
+template <class Place>
+MarchScene assemble_march_scene(const RenderInputs& in, Place& place) {
+  validate(in);
+  MarchScene scene{};
+  scene.density = {in.density->shape, place.place(in.density->tau_v)};
+  scene.n_bands = static_cast<int>(in.bands.size());
+  scene.min_transmittance = in.min_transmittance;
+  for (int b = 0; b < scene.n_bands; ++b) {
+    const RenderBand& band = in.bands[size_t(b)];
+    scene.extinction_ratio[b] = band.extinction_ratio;
+    scene.albedo[b] = band.albedo;
+    scene.table[b] = band.table ? place_table(*band.table, place) : TableView{};
+    scene.emission[b] = band.emission ? place.place(*band.emission) : nullptr;
+  }
+  scene.stars = place_star_views(in.stars, scene.n_bands, place);
+  scene.n_stars = static_cast<int>(in.stars.size());
+  return scene;
+}
+
+}  // namespace nebula
