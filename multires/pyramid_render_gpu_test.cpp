@@ -17,18 +17,9 @@ TEST(PyramidGpu, AgreesWithTheCpu) {
   std::string why;
   if (!gpu_available(&why)) GTEST_SKIP() << why;
   testing::OneStarScene s;
-  s.grid = testing::cube(40, 1.0f);  // 40 -> 20 -> 10 -> 5: odd at the last level
-  for (size_t c = 0; c < s.grid.tau_v.size(); ++c)
-    s.grid.tau_v[c] = 0.3f * philox_uniform4(5, 0, uint32_t(c), 0, 0).u0;
+  s.grid = testing::noise_cube(40, 0.3f, 5);  // 40 -> 20 -> 10 -> 5: odd at the last level
   s.table = testing::thin_table(0.6, 72, 10.0);
-  CameraSettings cs;
-  cs.position = {0.3f, -2.5f, -2.0f};
-  cs.look_at = {0, 0, 0};
-  cs.up = {0, 0, 1};
-  cs.fov_deg = 50;
-  cs.width = 90;
-  cs.height = 61;
-  s.finish({0.1f, 0.2f, -0.1f}, 100.0f, 0.6f, make_camera(cs));
+  s.finish({0.1f, 0.2f, -0.1f}, 100.0f, 0.6f, testing::oblique_camera(90, 61));
   const PyramidResult cpu = render_pyramid(s.inputs, 3, Backend::Cpu);
   const PyramidResult gpu = render_pyramid(s.inputs, 3, Backend::Cuda, true);
   ASSERT_EQ(gpu.levels.size(), 4u);

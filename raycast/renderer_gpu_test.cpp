@@ -16,18 +16,9 @@ TEST(RendererGpu, AgreesWithTheCpu) {
   std::string why;
   if (!gpu_available(&why)) GTEST_SKIP() << why;
   testing::OneStarScene s;
-  s.grid = testing::cube(48, 1.0f);
-  for (size_t c = 0; c < s.grid.tau_v.size(); ++c)
-    s.grid.tau_v[c] = 0.4f * philox_uniform4(3, 0, uint32_t(c), 0, 0).u0;
+  s.grid = testing::noise_cube(48, 0.4f, 3);
   s.table = testing::thin_table(0.6, 72, 10.0);
-  CameraSettings cs;
-  cs.position = {0.3f, -2.5f, -2.0f};
-  cs.look_at = {0, 0, 0};
-  cs.up = {0, 0, 1};
-  cs.fov_deg = 50;
-  cs.width = 96;
-  cs.height = 64;
-  s.finish({0.1f, 0.2f, -0.1f}, 100.0f, 0.6f, make_camera(cs));
+  s.finish({0.1f, 0.2f, -0.1f}, 100.0f, 0.6f, testing::oblique_camera(96, 64));
   for (MarchMode mode : {MarchMode{}, MarchMode{0.25f, true}}) {
     s.inputs.mode = mode;
     RenderStats cpu_stats, gpu_stats;

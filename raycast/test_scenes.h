@@ -4,7 +4,9 @@
 #include <memory>
 #include <vector>
 
+#include "core/camera.h"
 #include "core/grid.h"
+#include "core/philox.h"
 #include "illumination/optical_depth_bake.h"
 #include "montecarlo/henyey_greenstein.h"
 #include "raycast/renderer.h"
@@ -39,6 +41,27 @@ inline void fill_sphere(DensityGrid& g, float radius, float tau_v) {
     for (int y = 0; y < g.shape.ny; ++y)
       for (int x = 0; x < g.shape.nx; ++x)
         if (length(g.shape.centre(x, y, z)) <= radius) g.tau_v[g.shape.index(x, y, z)] = tau_v;
+}
+
+// A cube of n^3 voxels spanning [-1, 1]^3 with tau_v uniform in [0, scale)
+// (Philox noise of key `key`): the CPU-GPU comparisons' grid.
+inline DensityGrid noise_cube(int n, float scale, uint64_t key) {
+  DensityGrid g = cube(n, 1.0f);
+  for (size_t c = 0; c < g.tau_v.size(); ++c) g.tau_v[c] = scale * philox_uniform4(key, 0, uint32_t(c), 0, 0).u0;
+  return g;
+}
+
+// A perspective camera looking at the origin from below and in front, the
+// CPU-GPU comparisons' view.
+inline Camera oblique_camera(int width, int height) {
+  CameraSettings cs;
+  cs.position = {0.3f, -2.5f, -2.0f};
+  cs.look_at = {0, 0, 0};
+  cs.up = {0, 0, 1};
+  cs.fov_deg = 50;
+  cs.width = width;
+  cs.height = height;
+  return make_camera(cs);
 }
 
 // One band, one star: everything render() needs, owning the pieces.
