@@ -62,4 +62,27 @@ NEBULA_HD Uniform4 philox_uniform4(uint64_t seed, uint32_t draw, uint32_t s1, ui
           u32_to_open_unit(r.v3)};
 }
 
+// A stream of uniforms: Philox blocks (draw, s1, s2, s3) under `seed`, the
+// draw counter advancing, handed out four at a time. Which stream a path or
+// photon uses is the caller's choice of (s1, s2, s3); the same numbers come
+// on every backend and launch shape.
+struct UniformStream {
+  uint64_t seed;
+  uint32_t s1, s2, s3;
+  uint32_t draw = 0;
+  int left = 0;
+  Uniform4 buf{};
+  NEBULA_HD UniformStream(uint64_t seed_, uint32_t s1_, uint32_t s2_, uint32_t s3_)
+      : seed(seed_), s1(s1_), s2(s2_), s3(s3_) {}
+  NEBULA_HD float next() {
+    if (left == 0) {
+      buf = philox_uniform4(seed, draw++, s1, s2, s3);
+      left = 4;
+    }
+    const float v = left == 4 ? buf.u0 : (left == 3 ? buf.u1 : (left == 2 ? buf.u2 : buf.u3));
+    --left;
+    return v;
+  }
+};
+
 }  // namespace nebula

@@ -39,8 +39,8 @@
 #include "core/math.h"
 #include "core/philox.h"
 #include "core/vec3.h"
+#include "montecarlo/grid_transport.h"
 #include "montecarlo/henyey_greenstein.h"
-#include "truth/majorant_grid.h"
 
 namespace nebula {
 
@@ -76,121 +76,15 @@ struct PathCounters {
   uint64_t capped = 0;     // paths ended at kTruthMaxOrders
 };
 
-// Uniforms of one path: Philox blocks (draw, pixel, sample, purpose|band)
-// under the scene's seed, handed out four at a time. The same numbers on
-// every backend and launch shape.
-struct PathRng {
-  uint64_t seed;
-  uint32_t pixel, sample, stream;
-  uint32_t draw = 0;
-  int left = 0;
-  Uniform4 buf{};
-  NEBULA_HD PathRng(uint64_t seed_, uint32_t pixel_, uint32_t sample_, uint32_t band)
-      : seed(seed_), pixel(pixel_), sample(sample_), stream((kPurposeTruth << 8) | band) {}
-  NEBULA_HD float next() {
-    if (left == 0) {
-      buf = philox_uniform4(seed, draw++, pixel, sample, stream);
-      left = 4;
-    }
-    const float v = left == 4 ? buf.u0 : (left == 3 ? buf.u1 : (left == 2 ? buf.u2 : buf.u3));
-    --left;
-    return v;
-  }
+// Uniforms of one path: the stream (pixel, sample, purpose|band) under the
+// scene's seed.
+struct PathRng : UniformStream {
+  NEBULA_HD PathRng(uint64_t seed_, uint32_t pixel, uint32_t sample, uint32_t band)
+      : UniformStream(seed_, pixel, sample, (kPurposeTruth << 8) | band) {}
 };
 
-// tau_v of the voxel holding p (clamped to the grid).
-NEBULA_HD float tau_v_at(const DensityView& d, Vec3 p) {
-  const GridShape& g = d.shape;
-  const float inv = 1.0f / g.voxel;
-  int x = static_cast<int>(floorf((p.x - g.origin.x) * inv));
-  int y = static_cast<int>(floorf((p.y - g.origin.y) * inv));
-  int z = static_cast<int>(floorf((p.z - g.origin.z) * inv));
-  x = x < 0 ? 0 : (x >= g.nx ? g.nx - 1 : x);
-  y = y < 0 ? 0 : (y >= g.ny ? g.ny - 1 : y);
-  z = z < 0 ? 0 : (z >= g.nz ? g.nz - 1 : z);
-  return d.tau_v[g.index(x, y, z)];
-}
-
-// A length beyond which a ray from `origin` has left the grid.
-NEBULA_HD float beyond_grid(const GridShape& g, Vec3 origin) {
-  const Vec3 span = g.upper() - g.origin;
-  return length(origin - (g.origin + 0.5f * span)) + length(span) + g.voxel;
-}
-
-// Delta tracking from `origin` along unit `dir` in a band whose sigma_ext is
-// tau_v * scale: true and the collision point when a real collision happens
-// inside the grid, false when the ray leaves it.
-template <class Rng>
-NEBULA_HD bool delta_track(const PathScene& s, float scale, Vec3 origin, Vec3 dir, Rng& rng, Vec3& hit,
-                           PathCounters& c) {
-  const GridShape& g = s.density.shape;
-  float t0, t1;
-  if (!clip_to_grid(g, origin, dir, beyond_grid(g, origin), t0, t1)) return false;
-  float xi = -logf(rng.next());  // majorant optical depth to the next tentative collision
-  float t = t0;
-  bool collided = false;
-  traverse_segment_cells(s.majorant.shape, origin + t0 * dir, origin + t1 * dir,
-                         [&](int, int, int, size_t cell, float chord) -> bool {
-                           const float m = s.majorant.max_tau_v[cell] * scale;
-                           float left = chord;
-                           if (m > 0.0f) {
-                             while (xi < m * left) {
-                               const float step = xi / m;
-                               t += step;
-                               left -= step;
-                               ++c.tentative;
-                               const Vec3 p = origin + t * dir;
-                               if (rng.next() * m < tau_v_at(s.density, p) * scale) {
-                                 hit = p;
-                                 collided = true;
-                                 return false;
-                               }
-                               xi = -logf(rng.next());
-                             }
-                             xi -= m * left;
-                           }
-                           t += left;
-                           return true;
-                         });
-  return collided;
-}
-
-// Residual ratio tracking (Novak, Selle & Jarosz 2014) of the transmittance
-// from a to b: per majorant block, exp(-min * chord) exactly, times the
-// product of (1 - (sigma - min) / (max - min)) over tentative points drawn
-// at rate max - min. Unbiased; exact (no tentative point) in uniform blocks.
-template <class Rng>
-NEBULA_HD float ratio_track(const PathScene& s, float scale, Vec3 a, Vec3 b, Rng& rng, PathCounters& c) {
-  const GridShape& g = s.density.shape;
-  const Vec3 d = b - a;
-  const float len = length(d);
-  if (!(len > 0.0f)) return 1.0f;
-  const Vec3 dir = (1.0f / len) * d;
-  float t0, t1;
-  if (!clip_to_grid(g, a, dir, len, t0, t1)) return 1.0f;
-  float weight = 1.0f, control = 0.0f;
-  float t = t0;
-  traverse_segment_cells(s.majorant.shape, a + t0 * dir, a + t1 * dir,
-                         [&](int, int, int, size_t cell, float chord) -> bool {
-                           const float lo = s.majorant.min_tau_v[cell] * scale;
-                           const float residual = s.majorant.max_tau_v[cell] * scale - lo;
-                           control += lo * chord;
-                           if (residual > 0.0f) {
-                             float local = -logf(rng.next()) / residual;
-                             while (local < chord) {
-                               ++c.tentative;
-                               const float sigma = tau_v_at(s.density, a + (t + local) * dir) * scale;
-                               // In [0, 1] by the majorant grid's border; fmaxf never acts.
-                               weight *= fmaxf(0.0f, 1.0f - (sigma - lo) / residual);
-                               if (!(weight > 0.0f)) return false;
-                               local += -logf(rng.next()) / residual;
-                             }
-                           }
-                           t += chord;
-                           return true;
-                         });
-  return weight > 0.0f ? weight * expf(-control) : 0.0f;
-}
+// The scene's dust as the shared transport code reads it.
+NEBULA_HD GridMedium medium_of(const PathScene& s) { return GridMedium{s.density, s.majorant}; }
 
 // Exact emission radiance along the ray from `origin` in band b to the grid's
 // edge: sum over voxels of T_in (j / l) (1 - exp(-sigma c)) / sigma.
@@ -224,7 +118,7 @@ NEBULA_HD float star_light(const PathScene& s, int b, float scale, Vec3 x, Vec3 
   const float mu = dot(d, -dir) / sqrtf(r2);  // after scattering it goes back along the path
   const float t = s.exact_transmittance
                       ? expf(-s.extinction_ratio[b] * segment_optical_depth(s.density, x, star.position))
-                      : ratio_track(s, scale, x, star.position, rng, c);
+                      : ratio_track(medium_of(s), scale, x, star.position, rng, c.tentative);
   return star.power[b] * kInv4Pi / r2 * t * hg_phase(s.g[b], mu);
 }
 
@@ -288,7 +182,7 @@ NEBULA_HD float trace_path(const PathScene& s, int b, Vec3 origin, Vec3 dir, Rng
     }
     const Vec3 from = pos;
     Vec3 hit;
-    if (!delta_track(s, scale, pos, dir, rng, hit, c)) break;
+    if (!delta_track(medium_of(s), scale, pos, dir, rng, hit, c.tentative)) break;
     pos = hit;
     ++order;
     ++c.vertices;

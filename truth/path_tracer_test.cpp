@@ -86,7 +86,7 @@ TEST(PathTracer, RatioTrackingTransmittanceIsUnbiased) {
   PathCounters c;
   for (uint32_t i = 0; i < 40000; ++i) {
     PathRng rng(3, i, 0, 0);
-    m.add(ratio_track(h.scene, scale, a, b, rng, c));
+    m.add(ratio_track(medium_of(h.scene), scale, a, b, rng, c.tentative));
   }
   std::printf("ratio tracking: %.6f +- %.6f, exact %.6f\n", m.mean(), m.stderr_(), exact);
   EXPECT_NEAR(m.mean(), exact, 4 * m.stderr_() + 1e-5);
@@ -95,7 +95,7 @@ TEST(PathTracer, RatioTrackingTransmittanceIsUnbiased) {
   in.density = &u;
   const HostPathScene hu = prepare_path_scene(in);
   PathRng rng(3, 0, 0, 0);
-  const double uniform = ratio_track(hu.scene, scale, a, b, rng, c);
+  const double uniform = ratio_track(medium_of(hu.scene), scale, a, b, rng, c.tentative);
   EXPECT_NEAR(uniform, std::exp(-1.3 * segment_optical_depth(u.view(), a, b)), 2e-5 * uniform);
 }
 
@@ -114,7 +114,7 @@ TEST(PathTracer, DeltaTrackingCollidesWithProbabilityOneMinusT) {
   for (uint32_t i = 0; i < 40000; ++i) {
     PathRng rng(4, i, 0, 0);
     Vec3 hit;
-    m.add(delta_track(h.scene, 0.9f / g.shape.voxel, a, dir, rng, hit, c) ? 1.0 : 0.0);
+    m.add(delta_track(medium_of(h.scene), 0.9f / g.shape.voxel, a, dir, rng, hit, c.tentative) ? 1.0 : 0.0);
   }
   EXPECT_NEAR(m.mean(), p, 4 * std::sqrt(p * (1 - p) / m.n));
 }
@@ -300,7 +300,7 @@ TEST(PathTracer, VanDeHulstSlabThroughTheGrid) {
   const Mean Td = flux(0.0f, 1.0f);  // on the bottom face, looking up
   PathCounters c;
   PathRng rng(23, 0, 0, 0);
-  const double direct = ratio_track(h.scene, 1.0f, Vec3{0, 0, 0}, Vec3{0, 0, 8}, rng, c);
+  const double direct = ratio_track(medium_of(h.scene), 1.0f, Vec3{0, 0, 0}, Vec3{0, 0, 8}, rng, c.tentative);
   std::printf("slab: R = %.5f +- %.5f (0.09739), T = %.5f +- %.5f (0.66096), direct %.6f\n", R.mean(), R.stderr_(),
               Td.mean() + direct, Td.stderr_(), direct);
   EXPECT_NEAR(direct, std::exp(-2.0), 1e-6);

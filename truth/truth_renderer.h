@@ -12,7 +12,7 @@
 #include "core/grid.h"
 #include "core/image.h"
 #include "core/placement.h"
-#include "truth/majorant_grid.h"
+#include "montecarlo/majorant_grid.h"
 #include "truth/path_tracer.h"
 
 namespace nebula {

@@ -8,7 +8,7 @@ axial marcher in each skip mode, the ground truth), and compares the pixels of e
 of images byte for byte. Each binary gets its own table cache, so table generation is
 compared as well.
 
-    python3 validation/compare_builds.py --old OLD/bin/nebula --new build/bin/nebula
+    /usr/bin/python3 validation/compare_builds.py --old OLD/bin/nebula --new build/bin/nebula
 
 Prints one line per case and exits 1 when any pair differs or any run fails.
 """

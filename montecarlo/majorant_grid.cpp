@@ -1,4 +1,4 @@
-#include "truth/majorant_grid.h"
+#include "montecarlo/majorant_grid.h"
 
 #include <algorithm>
 #include <string>
