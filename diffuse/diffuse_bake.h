@@ -1,0 +1,102 @@
+#pragma once
+// The bake of the diffuse radiation field (docs/diffuse.md): per band, a
+// Monte-Carlo photon pass from the stars through the grid (diffuse_photon.h),
+// its track-length deposits summed into the field's harmonics, and each band's
+// response from its scattering table. View-independent: a camera move reuses
+// it; a change of the dust (albedo, g, R_V), the density or a star bakes again.
+// CPU (TBB) and CUDA run the same photons and give the same sums.
+#include <cstdint>
+#include <vector>
+
+#include "core/backend.h"
+#include "core/bands.h"
+#include "core/grid.h"
+#include "diffuse/diffuse_field.h"
+#include "diffuse/diffuse_photon.h"
+#include "montecarlo/majorant_grid.h"
+
+namespace nebula {
+
+class Progress;
+
+// A band as the bake reads it: a band with albedo > 0 needs its table (the
+// response); a band with albedo 0 gets no field.
+struct DiffuseBand : Band {
+  const ScatteringTable* table = nullptr;
+};
+
+struct DiffuseBakeOptions {
+  int degree = 3;                  // "diffuse_order": harmonics up to this degree, 0 to kMaxDiffuseDegree
+  int cells = 64;                  // "diffuse_cells": the field's cells along the grid's longest axis (at least)
+  uint64_t photons = 1u << 20;     // "diffuse_photons": per band, 1 to 2^32 - 1
+  uint64_t seed = 1;
+  int roulette_start = 3;          // collisions before Russian roulette plays
+  int majorant_block = 4;          // voxels per majorant block edge
+  int max_orders = 0;              // 0: every order; k > 0: light scattered at most k times (studies, tests)
+};
+
+struct DiffuseBakeStats {
+  double seconds = 0;                // the photon passes (CUDA events on the GPU)
+  uint64_t photons = 0;              // traced, all bands
+  PhotonCounters counters;
+  std::vector<double> noise;         // per band: relative L2 noise of the field's l = 0 part (its two halves); -1 without a field
+  size_t field_bytes = 0;            // the field kept for rendering
+  size_t work_bytes = 0;             // the pass's accumulators and copies, while it runs
+};
+
+// Throws ParameterError for an option out of range (named as above), Error
+// for inputs that disagree (a scattering band without a table, power sizes).
+DiffuseField bake_diffuse(const DensityGrid& density, const std::vector<DiffuseBand>& bands,
+                          const std::vector<StarLight>& stars, const DiffuseBakeOptions& options, Backend backend,
+                          DiffuseBakeStats* stats = nullptr, Progress* progress = nullptr);
+
+// One band's photon pass, as both backends run it: the inputs, and the raw
+// fixed-point sums with the pass's counters.
+struct DiffusePassInputs {
+  const DensityGrid* density = nullptr;
+  const MajorantGrid* majorant = nullptr;
+  std::vector<Vec3> stars;
+  std::vector<float> star_cdf;
+  Band band;
+  uint32_t band_index = 0;
+  GridShape cells;
+  int degree = 0;
+  uint64_t seed = 1;
+  int roulette_start = 3;
+  int max_orders = 0;
+};
+struct DiffusePassResult {
+  std::vector<unsigned long long> sums;  // [cell * n_coeffs + k], 36.28 fixed point, two's complement
+  std::vector<unsigned long long> odd;   // [cell]: the l = 0 sums of odd photons
+  PhotonCounters counters;
+  double seconds = 0;
+  size_t device_bytes = 0;
+};
+DiffusePassResult diffuse_pass_cpu(const DiffusePassInputs& in, uint64_t photons, Progress* progress);
+DiffusePassResult diffuse_pass_cuda(const DiffusePassInputs& in, uint64_t photons);
+
+// The pass's kernel scene, assembled once for both backends (core/placement.h).
+template <class Place>
+DiffusePhotonScene assemble_photon_scene(const DiffusePassInputs& in, Place& place) {
+  DiffusePhotonScene s;
+  s.medium.density = {in.density->shape, place.place(in.density->tau_v)};
+  s.medium.majorant = in.majorant->view();
+  s.medium.majorant.max_tau_v = place.place(in.majorant->max_tau_v);
+  s.medium.majorant.min_tau_v = place.place(in.majorant->min_tau_v);
+  s.ratio = in.band.extinction_ratio;
+  s.albedo = in.band.albedo;
+  s.g = in.band.g;
+  s.cells = in.cells;
+  s.degree = in.degree;
+  s.n_coeffs = sh_count(in.degree);
+  s.stars = place.place(in.stars);
+  s.star_cdf = place.place(in.star_cdf);
+  s.n_stars = static_cast<int>(in.stars.size());
+  s.seed = in.seed;
+  s.band = in.band_index;
+  s.roulette_start = in.roulette_start;
+  s.max_orders = in.max_orders;
+  return s;
+}
+
+}  // namespace nebula

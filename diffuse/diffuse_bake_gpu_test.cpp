@@ -1,0 +1,67 @@
+// The bake on the GPU runs the same photons with the same fixed-point sums as
+// the CPU; float contraction on the device can move a collision by an ulp and
+// so, rarely, a photon's path: the fields agree far within their own noise.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/gpu.h"
+#include "core/philox.h"
+#include "diffuse/diffuse_bake.h"
+#include "montecarlo/henyey_greenstein.h"
+
+namespace nebula {
+namespace {
+
+TEST(DiffuseBakeGpu, AgreesWithTheCpuWithinAFractionOfItsNoise) {
+  std::string why;
+  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  DensityGrid grid;
+  grid.shape.nx = grid.shape.ny = grid.shape.nz = 24;
+  grid.shape.voxel = 2.0f / 24;
+  grid.shape.origin = {-1, -1, -1};
+  grid.tau_v.resize(grid.shape.count());
+  for (size_t c = 0; c < grid.tau_v.size(); ++c) grid.tau_v[c] = 0.3f * philox_uniform4(9, 0, uint32_t(c), 0, 0).u0;
+  ScatteringTable table = ScatteringTable::make_axes(4.0, 9, AngularBinning::UniformTheta, 72);
+  for (int i = 0; i < table.n_tau(); ++i)
+    for (int k = 0; k < table.n_mu(); ++k)
+      table.P[table.index(i, k)] =
+          static_cast<float>(table.tau[i] * hg_bin_mean(0.6, table.mu_edges[k], table.mu_edges[k + 1]));
+  std::vector<DiffuseBand> bands(2);
+  bands[0].name = "B";
+  bands[0].extinction_ratio = 1.2f;
+  bands[1].name = "V";
+  for (DiffuseBand& b : bands) {
+    b.albedo = 0.7f;
+    b.g = 0.6f;
+    b.table = &table;
+  }
+  const std::vector<StarLight> stars{{{0.1f, 0.05f, -0.2f}, {50.0f, 40.0f}}, {{3.0f, 0.0f, 0.5f}, {80.0f, 90.0f}}};
+  DiffuseBakeOptions o;
+  o.degree = kMaxDiffuseDegree;
+  o.cells = 12;
+  o.photons = 200000;
+  DiffuseBakeStats cpu_stats, gpu_stats;
+  const DiffuseField cpu = bake_diffuse(grid, bands, stars, o, Backend::Cpu, &cpu_stats);
+  const DiffuseField gpu = bake_diffuse(grid, bands, stars, o, Backend::Cuda, &gpu_stats);
+  for (size_t b = 0; b < bands.size(); ++b) {
+    ASSERT_EQ(cpu.coeffs[b].size(), gpu.coeffs[b].size());
+    double diff = 0, norm = 0;
+    size_t equal = 0;
+    for (size_t i = 0; i < cpu.coeffs[b].size(); ++i) {
+      const double d = double(cpu.coeffs[b][i]) - gpu.coeffs[b][i];
+      diff += d * d;
+      norm += double(cpu.coeffs[b][i]) * cpu.coeffs[b][i];
+      equal += cpu.coeffs[b][i] == gpu.coeffs[b][i];
+    }
+    const double rel = std::sqrt(diff / norm);
+    std::printf("band %zu: CPU-GPU relative L2 difference %.3g (the field's noise %.3g), %.1f%% of coefficients equal\n",
+                b, rel, cpu_stats.noise[b], 100.0 * equal / cpu.coeffs[b].size());
+    EXPECT_LT(rel, 0.25 * cpu_stats.noise[b]) << "band " << b;
+    EXPECT_NEAR(cpu_stats.noise[b], gpu_stats.noise[b], 0.1 * cpu_stats.noise[b]);
+  }
+  EXPECT_EQ(cpu_stats.photons, gpu_stats.photons);
+}
+
+}  // namespace
+}  // namespace nebula

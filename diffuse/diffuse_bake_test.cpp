@@ -1,0 +1,286 @@
+#include "diffuse/diffuse_bake.h"
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <vector>
+
+#include "core/error.h"
+#include "core/math.h"
+#include "montecarlo/henyey_greenstein.h"
+
+namespace nebula {
+namespace {
+
+// A cube of n^3 voxels over [-1, 1]^3 of uniform tau_v.
+DensityGrid cube(int n, float tau_v) {
+  DensityGrid g;
+  g.shape.nx = g.shape.ny = g.shape.nz = n;
+  g.shape.voxel = 2.0f / n;
+  g.shape.origin = {-1, -1, -1};
+  g.tau_v.assign(g.shape.count(), tau_v);
+  return g;
+}
+
+// The optically thin table of one band (the response needs one).
+ScatteringTable thin_table(double g) {
+  ScatteringTable t = ScatteringTable::make_axes(2.0, 5, AngularBinning::UniformTheta, 72);
+  t.g = g;
+  for (int i = 0; i < t.n_tau(); ++i)
+    for (int k = 0; k < t.n_mu(); ++k)
+      t.P[t.index(i, k)] = static_cast<float>(t.tau[i] * hg_bin_mean(g, t.mu_edges[k], t.mu_edges[k + 1]));
+  return t;
+}
+
+void gauss_legendre(int n, double a, double b, std::vector<double>& x, std::vector<double>& w) {
+  x.resize(n);
+  w.resize(n);
+  for (int i = 0; i < n; ++i) {
+    double z = std::cos(kPiD * (i + 0.75) / (n + 0.5)), dp = 0;
+    for (int it = 0; it < 100; ++it) {
+      double p0 = 1, p1 = z;
+      for (int k = 2; k <= n; ++k) {
+        const double p2 = ((2 * k - 1) * z * p1 - (k - 1) * p0) / k;
+        p0 = p1;
+        p1 = p2;
+      }
+      dp = n * (z * p1 - p0) / (z * z - 1);
+      const double dz = p1 / dp;
+      z -= dz;
+      if (std::fabs(dz) < 1e-15) break;
+    }
+    x[i] = 0.5 * (a + b) + 0.5 * (b - a) * z;
+    w[i] = (b - a) / ((1 - z * z) * dp * dp);
+  }
+}
+
+// Entry and exit distances of the ray s + t d (unit d) through the box [lo, hi]; false when it misses.
+bool box_interval(const double s[3], const double d[3], const double lo[3], const double hi[3], double& t0, double& t1) {
+  t0 = -1e300;
+  t1 = 1e300;
+  for (int k = 0; k < 3; ++k) {
+    if (d[k] == 0) {
+      if (s[k] < lo[k] || s[k] > hi[k]) return false;
+      continue;
+    }
+    double a = (lo[k] - s[k]) / d[k], b = (hi[k] - s[k]) / d[k];
+    if (a > b) std::swap(a, b);
+    t0 = std::max(t0, a);
+    t1 = std::min(t1, b);
+  }
+  return t0 < t1;
+}
+
+// The fluence at x of light scattered once by a uniform cube [-1, 1]^3 of
+// extinction sigma and albedo a, isotropically, lit by a star of power phi at
+// `star`, leaving out the light scattered inside the voxel box [lo, hi] around
+// x (what the bake leaves to that voxel's table):
+//   a sigma phi / (16 pi^2) integral dV' exp(-sigma (r' + rho)) / (r'^2 rho^2),
+// in coordinates about the star (r'^2 cancels); along each direction the part
+// inside the excluded box is cut out of the r' integral, so the integrand stays
+// bounded (rho >= l / 2).
+double single_scattering_fluence(const double x[3], const double star[3], const double lo[3], const double hi[3],
+                                 double sigma, double albedo, double phi) {
+  std::vector<double> mu, wmu, r, wr;
+  gauss_legendre(160, -1, 1, mu, wmu);
+  const int n_phi = 320;
+  const double cube_lo[3] = {-1, -1, -1}, cube_hi[3] = {1, 1, 1};
+  double sum = 0;
+  for (size_t i = 0; i < mu.size(); ++i)
+    for (int j = 0; j < n_phi; ++j) {
+      const double ph = 2 * kPiD * (j + 0.5) / n_phi, st = std::sqrt(1 - mu[i] * mu[i]);
+      const double d[3] = {st * std::cos(ph), st * std::sin(ph), mu[i]};
+      double t0, t1;
+      box_interval(star, d, cube_lo, cube_hi, t0, t1);
+      const double end = t1;  // the star is inside the cube
+      double a0, a1;
+      std::vector<std::pair<double, double>> pieces;
+      if (box_interval(star, d, lo, hi, a0, a1) && a1 > 0) {
+        a0 = std::max(a0, 0.0);
+        if (a0 > 0) pieces.push_back({0.0, a0});
+        if (a1 < end) pieces.push_back({a1, end});
+      } else {
+        pieces.push_back({0.0, end});
+      }
+      double line = 0;
+      for (auto [p, q] : pieces) {
+        gauss_legendre(16, p, q, r, wr);
+        for (size_t k = 0; k < r.size(); ++k) {
+          const double xp[3] = {star[0] + r[k] * d[0], star[1] + r[k] * d[1], star[2] + r[k] * d[2]};
+          const double rho2 = (xp[0] - x[0]) * (xp[0] - x[0]) + (xp[1] - x[1]) * (xp[1] - x[1]) +
+                              (xp[2] - x[2]) * (xp[2] - x[2]);
+          line += wr[k] * std::exp(-sigma * (r[k] + std::sqrt(rho2))) / rho2;
+        }
+      }
+      sum += wmu[i] * (2 * kPiD / n_phi) * line;
+    }
+  return albedo * sigma * phi / (16 * kPiD * kPiD) * sum;
+}
+
+// The track-length estimator against the integral it estimates: the field's
+// l = 0 part of light scattered once, in a thin uniform cube, against a
+// quadrature of the single-scattering integral. The tolerance is 4 standard
+// errors of the mean of independent bakes (seeds), plus the quadrature's own
+// error (under 0.3%: it moves by less when its resolution is halved).
+TEST(DiffuseBake, FirstScatteredFieldIsTheSingleScatteringIntegral) {
+  const int n = 16;
+  const float tau_v = 0.005f;  // per voxel: the cube is 0.08 across, attenuation inside a voxel is negligible
+  const DensityGrid grid = cube(n, tau_v);
+  const ScatteringTable table = thin_table(0.0);
+  DiffuseBand band;
+  band.name = "V";
+  band.extinction_ratio = 1;
+  band.albedo = 0.5f;
+  band.g = 0.0f;
+  band.table = &table;
+  const Vec3 star{0.01f, 0.02f, 0.03f};
+  const std::vector<StarLight> stars{{star, {100.0f}}};
+  DiffuseBakeOptions o;
+  o.degree = 0;
+  o.cells = n;
+  o.photons = 1u << 18;
+  o.max_orders = 1;
+  const int runs = 8;
+  const int cells[3][3] = {{12, 8, 8}, {8, 3, 9}, {4, 12, 13}};  // 4 to 6 voxels from the star
+  std::vector<std::vector<double>> estimate(3);
+  for (int run = 0; run < runs; ++run) {
+    o.seed = 101 + run;
+    const DiffuseField f = bake_diffuse(grid, {band}, stars, o, Backend::Cpu);
+    ASSERT_EQ(f.shift, 0);
+    for (int c = 0; c < 3; ++c)
+      estimate[c].push_back(f.coeffs[0][f.cells.index(cells[c][0], cells[c][1], cells[c][2])] * std::sqrt(4 * kPiD));
+  }
+  const double sigma = tau_v / grid.shape.voxel, l = grid.shape.voxel;
+  const double s[3] = {star.x, star.y, star.z};
+  for (int c = 0; c < 3; ++c) {
+    double mean = 0, var = 0;
+    for (double e : estimate[c]) mean += e / runs;
+    for (double e : estimate[c]) var += (e - mean) * (e - mean) / (runs - 1);
+    const double se = std::sqrt(var / runs);
+    // The bake averages over the voxel; the quadrature takes its 2^3 Gauss points.
+    const double lo[3] = {-1 + cells[c][0] * l, -1 + cells[c][1] * l, -1 + cells[c][2] * l};
+    const double hi[3] = {lo[0] + l, lo[1] + l, lo[2] + l};
+    double expected = 0;
+    const double g = 0.5 / std::sqrt(3.0);
+    for (int k = 0; k < 8; ++k) {
+      const double x[3] = {lo[0] + l * (0.5 + ((k & 1) ? g : -g)), lo[1] + l * (0.5 + ((k & 2) ? g : -g)),
+                           lo[2] + l * (0.5 + ((k & 4) ? g : -g))};
+      expected += single_scattering_fluence(x, s, lo, hi, sigma, 0.5, 100.0) / 8;
+    }
+    std::printf("cell (%d, %d, %d): bake %.5g +- %.2g, single-scattering integral %.5g (%+.2f%%)\n", cells[c][0],
+                cells[c][1], cells[c][2], mean, se, expected, 100 * (mean / expected - 1));
+    EXPECT_LT(se, 0.02 * expected) << "too few photons for the test to mean anything";
+    EXPECT_NEAR(mean, expected, 4 * se + 0.003 * expected) << "cell " << c;
+  }
+}
+
+// Sums of fixed-point integers do not depend on the order they come in.
+TEST(DiffuseBake, TheSameFieldOnOneThreadOrMany) {
+  const DensityGrid grid = cube(8, 0.3f);
+  const ScatteringTable table = thin_table(0.6);
+  DiffuseBand band;
+  band.name = "V";
+  band.albedo = 0.8f;
+  band.g = 0.6f;
+  band.table = &table;
+  DiffuseBakeOptions o;
+  o.photons = 20000;
+  const std::vector<StarLight> stars{{{0.1f, -0.2f, 0.3f}, {1.0f}}};
+  const DiffuseField many = bake_diffuse(grid, {band}, stars, o, Backend::Cpu);
+  DiffuseField one;
+  {
+    tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+    one = bake_diffuse(grid, {band}, stars, o, Backend::Cpu);
+  }
+  ASSERT_EQ(many.coeffs[0].size(), one.coeffs[0].size());
+  for (size_t i = 0; i < one.coeffs[0].size(); ++i) ASSERT_EQ(many.coeffs[0][i], one.coeffs[0][i]) << i;
+}
+
+// The field's noise estimate (its two halves) falls as 1 / sqrt(photons).
+TEST(DiffuseBake, NoiseFallsAsOneOverTheRootOfThePhotons) {
+  const DensityGrid grid = cube(8, 0.2f);
+  const ScatteringTable table = thin_table(0.6);
+  DiffuseBand band;
+  band.name = "V";
+  band.albedo = 0.6f;
+  band.g = 0.6f;
+  band.table = &table;
+  DiffuseBakeOptions o;
+  const std::vector<StarLight> stars{{{0.0f, 0.0f, 0.0f}, {1.0f}}};
+  DiffuseBakeStats few, more;
+  o.photons = 20000;
+  bake_diffuse(grid, {band}, stars, o, Backend::Cpu, &few);
+  o.photons = 320000;
+  bake_diffuse(grid, {band}, stars, o, Backend::Cpu, &more);
+  std::printf("noise %.4f at 2e4 photons, %.4f at 3.2e5 (ratio %.2f, expected 4)\n", few.noise[0], more.noise[0],
+              few.noise[0] / more.noise[0]);
+  EXPECT_NEAR(few.noise[0] / more.noise[0], 4.0, 1.0);
+}
+
+TEST(DiffuseBake, RefusesBadOptionsNamingThem) {
+  const DensityGrid grid = cube(4, 0.1f);
+  const ScatteringTable table = thin_table(0.6);
+  DiffuseBand band;
+  band.name = "V";
+  band.table = &table;
+  const std::vector<StarLight> stars{{{0, 0, 0}, {1.0f}}};
+  auto parameter = [&](DiffuseBakeOptions o) {
+    try {
+      bake_diffuse(grid, {band}, stars, o, Backend::Cpu);
+    } catch (const ParameterError& e) {
+      return e.parameter();
+    }
+    return std::string("accepted");
+  };
+  DiffuseBakeOptions o;
+  o.photons = 1000;
+  EXPECT_EQ(parameter(o), "accepted");
+  o.degree = kMaxDiffuseDegree + 1;
+  EXPECT_EQ(parameter(o), "diffuse_order");
+  o = {};
+  o.cells = 0;
+  EXPECT_EQ(parameter(o), "diffuse_cells");
+  o = {};
+  o.photons = 0;
+  EXPECT_EQ(parameter(o), "diffuse_photons");
+  band.table = nullptr;
+  EXPECT_THROW(bake_diffuse(grid, {band}, stars, DiffuseBakeOptions{}, Backend::Cpu), Error);
+}
+
+// Hard cases: a star at a voxel corner and one inside a voxel of tau 1000,
+// g = +-0.99, albedo 1 and 0, an empty grid: every coefficient finite, and
+// nothing at all where nothing scatters.
+TEST(DiffuseBake, HardCasesStayFinite) {
+  DensityGrid grid = cube(8, 0.5f);
+  grid.tau_v[grid.shape.index(4, 4, 4)] = 1000.0f;
+  const DensityGrid empty = cube(8, 0.0f);
+  DiffuseBakeOptions o;
+  o.photons = 2000;
+  for (float g : {-0.99f, 0.0f, 0.99f})
+    for (float albedo : {0.0f, 0.5f, 1.0f})
+      for (Vec3 star : {Vec3{0.0f, 0.0f, 0.0f}, Vec3{0.1f, 0.1f, 0.1f}, Vec3{3.0f, 0.2f, -0.1f}})
+        for (const DensityGrid* d : {static_cast<const DensityGrid*>(&grid), &empty}) {
+          const ScatteringTable table = thin_table(g);
+          DiffuseBand band;
+          band.name = "V";
+          band.albedo = albedo;
+          band.g = g;
+          band.table = &table;
+          DiffuseBakeStats stats;
+          const DiffuseField f = bake_diffuse(*d, {band}, {{star, {10.0f}}}, o, Backend::Cpu, &stats);
+          if (albedo == 0 || d == &empty) {
+            for (float v : f.coeffs[0]) ASSERT_EQ(v, 0.0f);
+            continue;
+          }
+          double fluence = 0;
+          for (size_t i = 0; i < f.coeffs[0].size(); ++i) {
+            ASSERT_TRUE(std::isfinite(f.coeffs[0][i])) << "g " << g << " albedo " << albedo;
+            if (i % size_t(f.n_coeffs()) == 0) fluence += f.coeffs[0][i];
+          }
+          EXPECT_GT(fluence, 0.0) << "g " << g << " albedo " << albedo;
+        }
+}
+
+}  // namespace
+}  // namespace nebula

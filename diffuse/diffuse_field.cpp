@@ -1,0 +1,107 @@
+#include "diffuse/diffuse_field.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.h"
+#include "core/math.h"
+
+namespace nebula {
+
+void DiffuseField::pack() {
+  const size_t n = size_t(n_coeffs()), count = cells.count();
+  packed.assign(count * n * 4, 0.0f);
+  for (size_t b = 0; b < coeffs.size() && b < size_t(kMaxBands); ++b) {
+    if (coeffs[b].empty()) continue;
+    if (coeffs[b].size() != count * n) throw Error("diffuse field: band " + std::to_string(b) + " has the wrong size");
+    for (size_t i = 0; i < count * n; ++i) packed[i * 4 + b] = coeffs[b][i];
+  }
+}
+
+size_t DiffuseField::bytes() const {
+  size_t floats = packed.size() + response_tau_max.size();
+  for (const auto& r : response) floats += r.size();
+  return floats * sizeof(float);
+}
+
+DiffuseView DiffuseField::view() const {
+  DiffuseView v;
+  v.cells = cells;
+  v.shift = shift;
+  v.degree = degree;
+  v.packed = packed.data();
+  for (size_t b = 0; b < coeffs.size() && b < size_t(kMaxBands); ++b) {
+    if (coeffs[b].empty()) continue;
+    v.has[b] = true;
+    v.response[b] = response[b].data();
+    v.rows[b] = static_cast<int>(response[b].size() / size_t(diffuse_response_stride(degree)));
+    v.rows_per_tau[b] = float(v.rows[b] - 1) / response_tau_max[b];
+  }
+  return v;
+}
+
+std::vector<double> legendre_moments(const ScatteringTable& table, int n) {
+  const int n_tau = table.n_tau(), n_mu = table.n_mu();
+  if (n_tau < 2 || table.P.size() != size_t(n_tau) * n_mu)
+    throw Error("diffuse response: the scattering table has no rows");
+  // integral over bin k of P_l(mu) d mu = [P_{l+1} - P_{l-1}] / (2l + 1) between the edges (l >= 1).
+  std::vector<double> weight(size_t(n_mu) * (n + 1)), lo(n + 2), hi(n + 2);
+  for (int k = 0; k < n_mu; ++k) {
+    const double a = table.mu_edges[k], b = table.mu_edges[k + 1];
+    legendre(n + 1, a, lo.data());
+    legendre(n + 1, b, hi.data());
+    weight[size_t(k) * (n + 1)] = b - a;
+    for (int l = 1; l <= n; ++l)
+      weight[size_t(k) * (n + 1) + l] = ((hi[l + 1] - hi[l - 1]) - (lo[l + 1] - lo[l - 1])) / (2.0 * l + 1.0);
+  }
+  std::vector<double> out(size_t(n_tau) * (n + 1));
+  for (int i = 0; i < n_tau; ++i)
+    for (int l = 0; l <= n; ++l) {
+      double sum = 0;
+      for (int k = 0; k < n_mu; ++k) sum += double(table.P[table.index(i, k)]) * weight[size_t(k) * (n + 1) + l];
+      out[size_t(i) * (n + 1) + l] = 2.0 * kPiD * sum;
+    }
+  return out;
+}
+
+double lanczos_sigma(int l, int degree) {
+  if (l == 0) return 1.0;
+  const double x = kPiD * l / (degree + 1);
+  return std::sin(x) / x;
+}
+
+std::vector<float> delta_m_response(const ScatteringTable& table, int degree) {
+  if (degree < 0 || degree > kMaxDiffuseDegree)
+    throw ParameterError("diffuse_order", "must be 0 to " + std::to_string(kMaxDiffuseDegree) + ", got " +
+                                              std::to_string(degree));
+  const int n = degree + 1;
+  const std::vector<double> p = legendre_moments(table, n);
+  const int stride = diffuse_response_stride(degree);
+  std::vector<float> out(size_t(table.n_tau()) * stride, 0.0f);
+  for (int i = 0; i < table.n_tau(); ++i) {
+    const double* row = p.data() + size_t(i) * (n + 1);
+    const double peak = std::max(0.0, row[n]);
+    float* o = out.data() + size_t(i) * stride;
+    for (int l = 0; l <= degree; ++l) o[l] = static_cast<float>((row[l] - peak) * lanczos_sigma(l, degree));
+    o[degree + 1] = static_cast<float>(peak);
+  }
+  return out;
+}
+
+GridShape diffuse_cells(const GridShape& grid, int cells, int* shift) {
+  if (cells < 1) throw ParameterError("diffuse_cells", "must be at least 1, got " + std::to_string(cells));
+  const int longest = std::max({grid.nx, grid.ny, grid.nz});
+  int s = 0;
+  while ((longest >> (s + 1)) >= cells && s < 16) ++s;
+  const int f = 1 << s;
+  GridShape c;
+  c.nx = (grid.nx + f - 1) / f;
+  c.ny = (grid.ny + f - 1) / f;
+  c.nz = (grid.nz + f - 1) / f;
+  c.origin = grid.origin;
+  c.voxel = grid.voxel * float(f);
+  if (shift) *shift = s;
+  return c;
+}
+
+}  // namespace nebula

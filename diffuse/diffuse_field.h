@@ -1,0 +1,196 @@
+#pragma once
+// The diffuse radiation field (docs/diffuse.md): per band, the light that has
+// scattered at least once in *another* voxel, as it enters each voxel, in
+// real spherical harmonics on a grid of cells (f x f x f voxels each):
+//
+//   L_k(cell) = integral over directions d of L_in(d) Y_k(d),  L_sun pc^-2,
+//
+// L_in(d) the radiance propagating along d that enters the cell's voxels
+// (their own dust not yet crossed). A voxel responds to it through the
+// Legendre moments of its own table (DESIGN.md section 3, "Table"):
+//
+//   p_l(tau_sct) = 2 pi integral P(tau_sct, mu) P_l(mu) d mu,
+//
+// and by the addition theorem the light it scatters towards the eye, per unit
+// of chord / l as the direct term E P, is
+//
+//   S = integral L_in(d) P(tau_sct, d . e) dd = sum_l p_l(tau_sct) D_l,
+//   D_l = sum over m of Y_lm(e) L_lm,   e the direction to the eye.
+//
+// The table holds the voxel's internal multiple scattering of this light as
+// it does for starlight, so nothing is counted twice.
+//
+// Truncation, and the forward peak (delta-M, Wiscombe 1977, J. Atmos. Sci.
+// 34, 1408). Dust scatters forwards (g = 0.6 to 0.9): the series above
+// converges slowly, and cut at degree N it misplaces the peak's light by tens
+// of percent at g = 0.9. So the voxel's response is split into a forward peak
+// of strength p_{N+1} (a delta: light going on in its own direction) and the
+// rest, p*_l = p_l - p_{N+1} for l <= N, whose series the field's harmonics
+// answer. The peak's light is the radiance already travelling towards the
+// eye: the marcher keeps it by attenuating the ray through the voxel by
+// exp(-tau c / l) + p_{N+1} c / l instead of exp(-tau c / l) (raycast/).
+// The field itself is peaked where light streams away from a star, and its
+// truncated series rings (negative lobes behind the peak, which back-scatter
+// into the image); the series is therefore cut with Lanczos sigma factors,
+// sinc(l / (N + 1)), which smooth the field enough to damp the ringing
+// (docs/diffuse.md gives the measured choice of degree and factors).
+#include <cstddef>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "core/bands.h"
+#include "core/grid.h"
+#include "core/hd.h"
+#include "diffuse/spherical_harmonics.h"
+#include "tables/scattering_table.h"
+
+namespace nebula {
+
+constexpr int kMaxDiffuseDegree = 4;  // the marchers keep sum_m per degree, 5 per band, in registers
+
+// A response row: p*_0..p*_degree and the peak, padded to whole vector loads.
+NEBULA_HD constexpr int diffuse_response_stride(int degree) { return (degree + 2 + 3) / 4 * 4; }
+
+// Four floats at p (16-byte aligned): one vector load on the device.
+struct Quad {
+  float v[4];
+};
+NEBULA_HD Quad load_quad(const float* p) {
+#if NEBULA_ON_DEVICE
+  const float4 q = *reinterpret_cast<const float4*>(p);
+  return {{q.x, q.y, q.z, q.w}};
+#else
+  return {{p[0], p[1], p[2], p[3]}};
+#endif
+}
+
+// A kernel's view of a field, by value (host or device pointers). The
+// harmonics of all bands are interleaved, [cell][k][band of 4]: one vector
+// load per harmonic serves every band.
+struct DiffuseView {
+  GridShape cells;     // the field's cells; cell edge = 2^shift voxels
+  int shift = 0;
+  int degree = 0;      // l_max
+  const float* packed = nullptr;          // [(cell * (degree + 1)^2 + k) * 4 + band]
+  bool has[kMaxBands] = {};               // whether the band has a field (else its slots are 0)
+  const float* response[kMaxBands] = {};  // [row * stride + l]: p*_0..p*_degree, the peak p_{degree+1}, zeros
+  int rows[kMaxBands] = {};
+  float rows_per_tau[kMaxBands] = {};     // (rows - 1) / the table's tau_max
+
+  NEBULA_HD size_t cell_of(int x, int y, int z) const { return cells.index(x >> shift, y >> shift, z >> shift); }
+
+  // D[b][l] = sum over m of Y_lm(e) L_lm of band b at `cell`, with e the
+  // direction to the eye; kDeg is the field's degree, fixed at compile time
+  // so that D stays in registers.
+  template <int kDeg>
+  NEBULA_HD void project(size_t cell, Vec3 to_eye, float (&D)[kMaxBands][kDeg + 1]) const {
+    constexpr int n = (kDeg + 1) * (kDeg + 1);
+    float y[n];
+    sh_basis(kDeg, to_eye, y);
+    NEBULA_UNROLL
+    for (int b = 0; b < kMaxBands; ++b)
+      NEBULA_UNROLL
+      for (int l = 0; l <= kDeg; ++l) D[b][l] = 0.0f;
+    const float* c = packed + cell * size_t(n) * 4;
+    NEBULA_UNROLL
+    for (int k = 0; k < n; ++k) {
+      const Quad q = load_quad(c + 4 * k);
+      const int l = sh_degree_of(k);
+      NEBULA_UNROLL
+      for (int b = 0; b < kMaxBands; ++b) D[b][l] += y[k] * q.v[b];
+    }
+  }
+
+  // sum_l p*_l(tau_sct) D_l for band b, and the forward peak p_{N+1}(tau_sct)
+  // in *peak: the response, linear between table rows (clamped to the last
+  // one, as the table lookup is). Both rows' sums are taken, then
+  // interpolated: fewer operations than interpolating each moment.
+  template <int kDeg>
+  NEBULA_HD float scattered(int b, float tau_sct, const float (&D)[kDeg + 1], float* peak) const {
+    const float u = fminf(fmaxf(tau_sct * rows_per_tau[b], 0.0f), float(rows[b] - 1));
+    int i = static_cast<int>(u);
+    i = i > rows[b] - 2 ? rows[b] - 2 : i;
+    const float f = u - float(i);
+    constexpr int stride = diffuse_response_stride(kDeg);
+    const float* r0 = response[b] + size_t(i) * stride;
+    float s[2] = {0.0f, 0.0f}, p[2] = {0.0f, 0.0f};
+    NEBULA_UNROLL
+    for (int row = 0; row < 2; ++row)
+      NEBULA_UNROLL
+      for (int q = 0; q < stride / 4; ++q) {
+        const Quad r = load_quad(r0 + row * stride + 4 * q);
+        NEBULA_UNROLL
+        for (int j = 0; j < 4; ++j) {
+          const int l = 4 * q + j;
+          if (l <= kDeg) s[row] += r.v[j] * D[l < kDeg ? l : kDeg];
+          if (l == kDeg + 1) p[row] = r.v[j];
+        }
+      }
+    *peak = p[0] + f * (p[1] - p[0]);
+    return s[0] + f * (s[1] - s[0]);
+  }
+
+  // The forward peak p_{N+1}(tau_sct) of band b alone (the marcher's
+  // transmittance, any degree).
+  NEBULA_HD float peak(int b, float tau_sct) const {
+    const float u = fminf(fmaxf(tau_sct * rows_per_tau[b], 0.0f), float(rows[b] - 1));
+    int i = static_cast<int>(u);
+    i = i > rows[b] - 2 ? rows[b] - 2 : i;
+    const float f = u - float(i);
+    const int stride = diffuse_response_stride(degree);
+    const float* r = response[b] + size_t(i) * stride + degree + 1;
+    return r[0] + f * (r[stride] - r[0]);
+  }
+};
+
+// Calls f(std::integral_constant<int, degree>) for a field's degree, 0 to
+// kMaxDiffuseDegree: the one place that turns it into a template argument.
+template <class F>
+decltype(auto) dispatch_diffuse_degree(int degree, F&& f) {
+  switch (degree) {
+    case 0: return f(std::integral_constant<int, 0>{});
+    case 1: return f(std::integral_constant<int, 1>{});
+    case 2: return f(std::integral_constant<int, 2>{});
+    case 3: return f(std::integral_constant<int, 3>{});
+    default: break;
+  }
+  static_assert(kMaxDiffuseDegree == 4, "one case per degree");
+  return f(std::integral_constant<int, 4>{});
+}
+
+// The owning field.
+struct DiffuseField {
+  GridShape cells;
+  int shift = 0;   // a cell spans 2^shift voxels per axis
+  int degree = 3;
+  std::vector<std::vector<float>> coeffs;    // [band]: [cell * n_coeffs + k]; empty where the band has no field
+  std::vector<float> packed;                 // the bands interleaved for kernels (pack())
+  std::vector<std::vector<float>> response;  // [band]: per table row, p*_0..p*_degree, the peak, padding (delta_m_response)
+  std::vector<float> response_tau_max;       // [band]
+
+  int n_coeffs() const { return sh_count(degree); }
+  // Builds `packed` from `coeffs`: [(cell * n_coeffs + k) * 4 + band], 0 for bands without a field.
+  void pack();
+  size_t bytes() const;       // what a kernel reads: packed and the responses
+  DiffuseView view() const;   // host pointers (pack() first)
+};
+
+// p_0 .. p_n of every row of `table` (row-major, n + 1 per row): the table's
+// bins are its averages over their mu ranges, so each bin contributes its
+// value times the exact integral of P_l over the bin.
+std::vector<double> legendre_moments(const ScatteringTable& table, int n);
+
+// The response a field of this degree uses, per row (diffuse_response_stride
+// values): the forward peak p_{N+1} (0 where it is negative, in thick voxels that scatter
+// mostly backwards) and sigma_l (p_l - peak) for l <= N, then zeros.
+std::vector<float> delta_m_response(const ScatteringTable& table, int degree);
+// Lanczos's sigma factor of degree l in a series cut at `degree`: sinc(l / (degree + 1)), 1 at l = 0.
+double lanczos_sigma(int l, int degree);
+
+// The field's cells for a grid: the largest power-of-2 cell edge f (in
+// voxels) with at least `cells` of them along the grid's longest axis (f = 1
+// when the grid has no more), each axis covered by ceil(n / f) cells.
+GridShape diffuse_cells(const GridShape& grid, int cells, int* shift);
+
+}  // namespace nebula

@@ -1,0 +1,142 @@
+#include "diffuse/diffuse_field.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/error.h"
+#include "core/math.h"
+#include "montecarlo/henyey_greenstein.h"
+
+namespace nebula {
+namespace {
+
+// The optically thin table P = tau_sct x (bin mean of p_HG), on n_mu uniform-theta bins.
+ScatteringTable thin_table(double g, int n_mu, double tau_max = 2.0, int n_tau = 5) {
+  ScatteringTable t = ScatteringTable::make_axes(tau_max, n_tau, AngularBinning::UniformTheta, n_mu);
+  t.g = g;
+  for (int i = 0; i < t.n_tau(); ++i)
+    for (int k = 0; k < n_mu; ++k)
+      t.P[t.index(i, k)] = static_cast<float>(t.tau[i] * hg_bin_mean(g, t.mu_edges[k], t.mu_edges[k + 1]));
+  return t;
+}
+
+// p_l of an optically thin voxel is tau_sct g^l (the HG Legendre moments);
+// the bins blur the forward peak a little, less with more of them.
+TEST(DiffuseResponse, ThinTableGivesTheHgMoments) {
+  for (double g : {0.0, 0.6, 0.9}) {
+    const ScatteringTable t = thin_table(g, 720);
+    const std::vector<double> p = legendre_moments(t, 4);
+    ASSERT_EQ(p.size(), size_t(t.n_tau()) * 5);
+    for (int i = 0; i < t.n_tau(); ++i)
+      for (int l = 0; l <= 4; ++l) {
+        const double expected = t.tau[i] * std::pow(g, l);
+        // l = 0 is exact but for the table's float32 values (2^-24 relative
+        // each): the bins' means times their widths add up to the whole.
+        EXPECT_NEAR(p[size_t(i) * 5 + l], expected, l == 0 ? 4 * 0x1p-24 * (1 + expected) : 2e-3 * t.tau[i])
+            << "g " << g << " row " << i << " l " << l;
+      }
+  }
+}
+
+// The delta-M split: a peak of p_{N+1}, the rest p_l - p_{N+1}, cut with
+// Lanczos's sigma factors.
+TEST(DiffuseResponse, DeltaMSplitsOffTheForwardPeak) {
+  const ScatteringTable t = thin_table(0.9, 720);
+  for (int degree = 0; degree <= kMaxDiffuseDegree; ++degree) {
+    const std::vector<float> r = delta_m_response(t, degree);
+    const std::vector<double> p = legendre_moments(t, degree + 1);
+    const int stride = diffuse_response_stride(degree);
+    ASSERT_EQ(stride % 4, 0) << "rows are whole vector loads";
+    ASSERT_GE(stride, degree + 2);
+    ASSERT_EQ(r.size(), size_t(t.n_tau()) * stride);
+    for (int i = 0; i < t.n_tau(); ++i) {
+      const float* row = r.data() + size_t(i) * stride;
+      for (int j = degree + 2; j < stride; ++j) EXPECT_EQ(row[j], 0.0f) << "padding";
+      const double peak = p[size_t(i) * (degree + 2) + degree + 1];
+      EXPECT_NEAR(row[degree + 1], peak, 1e-6 * (1 + peak));
+      EXPECT_NEAR(row[degree + 1], t.tau[i] * std::pow(0.9, degree + 1), 2e-3 * t.tau[i]);
+      for (int l = 0; l <= degree; ++l)
+        EXPECT_NEAR(row[l], (p[size_t(i) * (degree + 2) + l] - peak) * lanczos_sigma(l, degree), 1e-6 * (1 + t.tau[i]));
+    }
+  }
+  EXPECT_THROW(delta_m_response(t, kMaxDiffuseDegree + 1), ParameterError);
+}
+
+template <int kDeg>
+void check_truncated_series(const ScatteringTable& t) {
+  const int degree = kDeg;
+  DiffuseField f;
+  f.degree = degree;
+  f.cells.nx = f.cells.ny = f.cells.nz = 1;
+  const Vec3 d0 = normalize(Vec3{0.3f, -0.5f, 0.8f}), e = normalize(Vec3{-0.2f, 0.1f, 0.9f});
+  const float E = 2.5f;
+  float y[kMaxShCoeffs];
+  sh_basis(degree, d0, y);
+  f.coeffs = {std::vector<float>(y, y + sh_count(degree))};
+  for (float& v : f.coeffs[0]) v *= E;
+  f.response = {delta_m_response(t, degree)};
+  f.response_tau_max = {float(t.tau_max())};
+  f.pack();
+  const DiffuseView v = f.view();
+  ASSERT_TRUE(v.has[0]);
+  ASSERT_FALSE(v.has[1]);
+  float D[kMaxBands][kDeg + 1];
+  v.project<kDeg>(0, e, D);
+  for (int b = 1; b < kMaxBands; ++b)
+    for (int l = 0; l <= kDeg; ++l) EXPECT_EQ(D[b][l], 0.0f) << "a band without a field reads zeros";
+  double p[kMaxDiffuseDegree + 2];
+  legendre(kMaxDiffuseDegree + 1, dot(d0, e), p);
+  for (double tau : {0.0, 0.25, 1.0, 1.3, 2.0}) {
+    // Between rows the response is linear in tau, as the table is.
+    const double peak = tau * std::pow(0.6, degree + 1);
+    double expected = 0;
+    for (int l = 0; l <= degree; ++l) {
+      const double sigma = l == 0 ? 1.0 : std::sin(kPiD * l / (degree + 1)) / (kPiD * l / (degree + 1));
+      expected += (2 * l + 1) / (4 * kPiD) * (tau * std::pow(0.6, l) - peak) * sigma * p[l];
+    }
+    float got_peak = -1;
+    EXPECT_NEAR(v.scattered<kDeg>(0, float(tau), D[0], &got_peak), E * expected, 3e-3 * E * tau + 1e-6)
+        << "degree " << degree << " tau " << tau;
+    EXPECT_NEAR(got_peak, peak, 3e-3 * tau + 1e-7);
+  }
+  // Beyond the table the last row holds (as lookups clamp).
+  float a = 0, b = 0;
+  EXPECT_FLOAT_EQ(v.scattered<kDeg>(0, 5.0f, D[0], &a), v.scattered<kDeg>(0, 2.0f, D[0], &b));
+  EXPECT_FLOAT_EQ(a, b);
+}
+
+// A parallel beam of irradiance E along d0 has harmonics E Y_k(d0); the
+// voxel's response towards e must be E times the delta-M rest's Legendre
+// series truncated at the field's degree with Lanczos's factors (the
+// addition theorem).
+TEST(DiffuseResponse, ScatteredLightIsTheTruncatedLegendreSeries) {
+  const ScatteringTable t = thin_table(0.6, 180, 2.0, 5);
+  for (int degree = 0; degree <= kMaxDiffuseDegree; ++degree)
+    dispatch_diffuse_degree(degree, [&](auto deg) { check_truncated_series<deg()>(t); });
+}
+
+TEST(DiffuseCells, PowersOfTwoWithAtLeastTheCellsAsked) {
+  GridShape g;
+  g.nx = 256;
+  g.ny = 128;
+  g.nz = 100;
+  g.voxel = 0.5f;
+  int shift = -1;
+  GridShape c = diffuse_cells(g, 64, &shift);
+  EXPECT_EQ(shift, 2);
+  EXPECT_EQ(c.nx, 64);
+  EXPECT_EQ(c.ny, 32);
+  EXPECT_EQ(c.nz, 25);
+  EXPECT_FLOAT_EQ(c.voxel, 2.0f);
+  c = diffuse_cells(g, 1000, &shift);
+  EXPECT_EQ(shift, 0);
+  EXPECT_EQ(c.nx, 256);
+  g.nz = 101;
+  c = diffuse_cells(g, 64, &shift);
+  EXPECT_EQ(c.nz, 26);  // ceil(101 / 4)
+  EXPECT_THROW(diffuse_cells(g, 0, &shift), ParameterError);
+}
+
+}  // namespace
+}  // namespace nebula

@@ -1,0 +1,191 @@
+#pragma once
+// One photon of the diffuse bake (docs/diffuse.md), written once for host and
+// device: emitted by a star, its first collision forced, then traced by delta
+// tracking (montecarlo/grid_transport.h) with Henyey-Greenstein scattering,
+// weight x albedo at each collision and Russian roulette. Every flight after a
+// collision deposits, into the field's cells it crosses, its weight x chord x
+// Y_k(direction): the track-length estimator of the harmonics of the radiance
+// entering each voxel. What a flight deposits:
+//   * nothing of the first flight (from the star): direct light, which the
+//     marcher takes from the per-star bake;
+//   * nothing inside the voxel where the flight starts: light scattered in a
+//     voxel and still inside it is that voxel's own multiple scattering,
+//     which its table holds;
+//   * the whole chord of the voxel where the flight ends in a collision, as
+//     of every voxel it crosses before: the radiance *entering* a voxel is
+//     wanted, before its own dust (which the table also holds) acts on it.
+// Deposits are 36.28 fixed-point integers, so sums do not depend on the order
+// of the additions: the same field for any thread count or launch shape.
+#include <cstdint>
+
+#include "core/dda.h"
+#include "core/grid.h"
+#include "core/hd.h"
+#include "core/math.h"
+#include "core/philox.h"
+#include "diffuse/spherical_harmonics.h"
+#include "montecarlo/grid_transport.h"
+#include "montecarlo/henyey_greenstein.h"
+
+namespace nebula {
+
+constexpr uint32_t kPurposeDiffuse = 0x4446u;  // "DF"
+constexpr int kDiffuseMaxOrders = 10000;  // a photon is stopped (and counted) beyond this
+constexpr float kDiffuseFixedScale = 268435456.0f;  // 2^28: one unit of weight x cell edge
+
+// One band's photon pass, by value (host or device pointers).
+struct DiffusePhotonScene {
+  GridMedium medium;
+  float ratio = 1;       // A_b / A_V
+  float albedo = 0, g = 0;
+  GridShape cells;       // the field's cells
+  int degree = 0;
+  int n_coeffs = 1;
+  const Vec3* stars = nullptr;     // positions
+  const float* star_cdf = nullptr; // cumulative band power fractions, last = 1
+  int n_stars = 0;
+  uint64_t seed = 1;
+  uint32_t band = 0;
+  int roulette_start = 3;
+  int max_orders = 0;   // 0: every order; k > 0: flights after collisions 1..k only (tests, studies)
+};
+
+struct PhotonCounters {
+  uint64_t collisions = 0;  // real collisions after the first
+  uint64_t tentative = 0;   // tentative collisions of delta tracking
+  uint64_t crossings = 0;   // field cells a deposit crossed
+  uint64_t capped = 0;      // photons stopped at kDiffuseMaxOrders
+};
+
+// Distance along unit `dir` from p to where it leaves the voxel holding p.
+NEBULA_HD float voxel_exit(const GridShape& g, Vec3 p, Vec3 dir) {
+  const int n[3] = {g.nx, g.ny, g.nz};
+  float t = 3.0e38f;
+  for (int k = 0; k < 3; ++k) {
+    const float o = detail::axis(g.origin, k), pk = detail::axis(p, k), dk = detail::axis(dir, k);
+    int i = static_cast<int>(floorf((pk - o) / g.voxel));
+    i = i < 0 ? 0 : (i >= n[k] ? n[k] - 1 : i);
+    const float lo = o + g.voxel * float(i), hi = lo + g.voxel;
+    if (dk > 0.0f) t = fminf(t, (hi - pk) / dk);
+    if (dk < 0.0f) t = fminf(t, (lo - pk) / dk);
+  }
+  return fmaxf(t, 0.0f);
+}
+
+// The point where the ray from `origin` along `dir` has crossed V-band depth
+// `target` x (A_V/A_b) (band depth `target`), walking the voxels exactly.
+NEBULA_HD Vec3 point_at_depth(const DensityView& d, float ratio, Vec3 origin, Vec3 dir, float far, float target) {
+  const float inv_l = ratio / d.shape.voxel;
+  float t0, t1;
+  clip_to_grid(d.shape, origin, dir, far, t0, t1);
+  float t = t0, depth = 0.0f, hit = t1;
+  traverse_segment_cells(d.shape, origin + t0 * dir, origin + t1 * dir,
+                         [&](int, int, int, size_t cell, float chord) -> bool {
+                           const float sigma = d.tau_v[cell] * inv_l;
+                           const float step = sigma * chord;
+                           if (depth + step >= target && sigma > 0.0f) {
+                             hit = t + (target - depth) / sigma;
+                             return false;
+                           }
+                           depth += step;
+                           t += chord;
+                           return true;
+                         });
+  return origin + fminf(hit, t1) * dir;
+}
+
+// Traces photon `photon` of the band; deposit(index, fixed_value) adds to
+// accumulator `index` = cell * n_coeffs + k. `odd` receives the l = 0 deposits
+// of odd photons again (the field's noise from its two halves).
+template <class Deposit, class DepositOdd>
+NEBULA_HD void trace_diffuse_photon(const DiffusePhotonScene& s, uint32_t photon, Deposit&& deposit,
+                                    DepositOdd&& deposit_odd, PhotonCounters& c) {
+  if (s.n_stars == 0 || !(s.albedo > 0.0f)) return;
+  UniformStream rng(s.seed, photon, s.band, kPurposeDiffuse);
+  const DensityView& dens = s.medium.density;
+  const GridShape& g = dens.shape;
+  // The star, by band power.
+  const float u_star = rng.next();
+  int k = 0;
+  while (k < s.n_stars - 1 && u_star > s.star_cdf[k]) ++k;
+  const Vec3 origin = s.stars[k];
+  // Emission: isotropic, or into the cone of the grid's bounding sphere when
+  // the star is outside it (weight: the cone's share of all directions).
+  const Vec3 centre = g.origin + 0.5f * (g.upper() - g.origin);
+  const float radius = 0.5f * length(g.upper() - g.origin);
+  const Vec3 to_centre = centre - origin;
+  const float distance = length(to_centre);
+  float weight = 1.0f;
+  float cos_theta, sin_phi, cos_phi;
+  Vec3 axis{0.0f, 0.0f, 1.0f};
+  const float u0 = rng.next(), u1 = rng.next();
+  sin_cos_2pi(u1, sin_phi, cos_phi);
+  if (distance > radius * 1.0001f) {
+    const float cos_max = sqrtf(fmaxf(0.0f, 1.0f - (radius / distance) * (radius / distance)));
+    cos_theta = 1.0f - u0 * (1.0f - cos_max);
+    weight = 0.5f * (1.0f - cos_max);
+    axis = (1.0f / distance) * to_centre;
+  } else {
+    cos_theta = 1.0f - 2.0f * u0;
+  }
+  Vec3 dir = scatter_direction(axis, HgSample{cos_theta, sqrtf(fmaxf(0.0f, 1.0f - cos_theta * cos_theta))}, sin_phi,
+                               cos_phi);
+  // The first collision, forced: weight x (1 - exp(-tau)) along the whole ray.
+  const float far = beyond_grid(g, origin);
+  const float tau = s.ratio * segment_optical_depth(dens, origin, origin + far * dir);
+  if (!(tau > 0.0f)) return;
+  const float interacts = -expm1f(-tau);
+  weight *= interacts;
+  const float target = -log1pf(-rng.next() * interacts);
+  Vec3 pos = point_at_depth(dens, s.ratio, origin, dir, far, target);
+  const float scale = s.ratio / g.voxel;
+  const bool odd = (photon & 1u) != 0u;
+  float y[kMaxShCoeffs];
+  for (int order = 1;; ++order) {
+    weight *= s.albedo;
+    if (!(weight > 0.0f)) break;
+    if (order >= s.roulette_start) {
+      const float q = fminf(1.0f, weight);
+      if (rng.next() >= q) break;
+      weight /= q;
+    }
+    if (order > kDiffuseMaxOrders) {
+      ++c.capped;
+      break;
+    }
+    const float ua = rng.next(), ub = rng.next();
+    float sp, cp;
+    sin_cos_2pi(ub, sp, cp);
+    dir = scatter_direction(dir, hg_sample(s.g, ua), sp, cp);
+    Vec3 hit;
+    const bool collided = delta_track(s.medium, scale, pos, dir, rng, hit, c.tentative);
+    // Deposit from where the flight leaves its first voxel to where it leaves
+    // the voxel of its collision (or the grid).
+    float t_end;
+    if (collided) {
+      t_end = length(hit - pos) + voxel_exit(g, hit, dir);
+    } else {
+      float t0, t1;
+      t_end = clip_to_grid(g, pos, dir, beyond_grid(g, pos), t0, t1) ? t1 : 0.0f;
+    }
+    const float t_start = voxel_exit(g, pos, dir);
+    if (t_end > t_start) {
+      sh_basis(s.degree, dir, y);
+      const float inv_edge = 1.0f / s.cells.voxel;
+      traverse_segment_cells(s.cells, pos + t_start * dir, pos + t_end * dir,
+                             [&](int, int, int, size_t cell, float chord) {
+                               ++c.crossings;
+                               const float w = weight * chord * inv_edge * kDiffuseFixedScale;
+                               const size_t base = cell * size_t(s.n_coeffs);
+                               for (int j = 0; j < s.n_coeffs; ++j)
+                                 deposit(base + size_t(j), static_cast<unsigned long long>(llrintf(w * y[j])));
+                               if (odd) deposit_odd(cell, static_cast<unsigned long long>(llrintf(w * y[0])));
+                             });
+    }
+    if (!collided || (s.max_orders > 0 && order >= s.max_orders)) break;
+    pos = hit;
+    ++c.collisions;
+  }
+}
+
+}  // namespace nebula

@@ -1,0 +1,89 @@
+#include "diffuse/spherical_harmonics.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "core/math.h"
+#include "core/philox.h"
+
+namespace nebula {
+namespace {
+
+// Gauss-Legendre nodes and weights on [-1, 1] (Newton on P_n).
+void gauss_legendre(int n, std::vector<double>& x, std::vector<double>& w) {
+  x.resize(n);
+  w.resize(n);
+  for (int i = 0; i < n; ++i) {
+    double z = std::cos(kPiD * (i + 0.75) / (n + 0.5)), dp = 0;
+    for (int it = 0; it < 100; ++it) {
+      double p0 = 1, p1 = z;
+      for (int k = 2; k <= n; ++k) {
+        const double p2 = ((2 * k - 1) * z * p1 - (k - 1) * p0) / k;
+        p0 = p1;
+        p1 = p2;
+      }
+      dp = n * (z * p1 - p0) / (z * z - 1);
+      const double dz = p1 / dp;
+      z -= dz;
+      if (std::fabs(dz) < 1e-15) break;
+    }
+    x[i] = z;
+    w[i] = 2 / ((1 - z * z) * dp * dp);
+  }
+}
+
+// A product rule exact for polynomials of degree <= 2 x 4 on the sphere.
+TEST(SphericalHarmonics, AreOrthonormal) {
+  std::vector<double> mu, wmu;
+  gauss_legendre(12, mu, wmu);
+  const int n_phi = 24;
+  double gram[kMaxShCoeffs][kMaxShCoeffs] = {};
+  float y[kMaxShCoeffs];
+  for (size_t i = 0; i < mu.size(); ++i)
+    for (int j = 0; j < n_phi; ++j) {
+      const double phi = 2 * kPiD * (j + 0.5) / n_phi, s = std::sqrt(1 - mu[i] * mu[i]);
+      sh_basis(kMaxShDegree, Vec3{float(s * std::cos(phi)), float(s * std::sin(phi)), float(mu[i])}, y);
+      const double w = wmu[i] * 2 * kPiD / n_phi;
+      for (int a = 0; a < kMaxShCoeffs; ++a)
+        for (int b = 0; b < kMaxShCoeffs; ++b) gram[a][b] += w * y[a] * y[b];
+    }
+  for (int a = 0; a < kMaxShCoeffs; ++a)
+    for (int b = 0; b < kMaxShCoeffs; ++b) EXPECT_NEAR(gram[a][b], a == b ? 1.0 : 0.0, 2e-6) << a << ", " << b;
+}
+
+TEST(SphericalHarmonics, AddUpToLegendrePolynomials) {
+  float ya[kMaxShCoeffs], yb[kMaxShCoeffs];
+  double p[kMaxShDegree + 1];
+  for (uint32_t t = 0; t < 200; ++t) {
+    const Uniform4 u = philox_uniform4(7, 0, t, 0, 0);
+    auto direction = [](float a, float b) {
+      const float z = 1 - 2 * a, s = std::sqrt(1 - z * z), phi = 2 * kPi * b;
+      return Vec3{s * std::cos(phi), s * std::sin(phi), z};
+    };
+    const Vec3 a = direction(u.u0, u.u1), b = direction(u.u2, u.u3);
+    sh_basis(kMaxShDegree, a, ya);
+    sh_basis(kMaxShDegree, b, yb);
+    legendre(kMaxShDegree, dot(a, b), p);
+    for (int l = 0; l <= kMaxShDegree; ++l) {
+      double sum = 0;
+      for (int k = l * l; k < (l + 1) * (l + 1); ++k) sum += double(ya[k]) * yb[k];
+      EXPECT_NEAR(sum, (2 * l + 1) / (4 * kPiD) * p[l], 2e-6) << "l = " << l;
+    }
+  }
+}
+
+TEST(SphericalHarmonics, LegendreMatchesItsClosedForms) {
+  double p[5];
+  for (double mu : {-1.0, -0.3, 0.0, 0.5, 1.0}) {
+    legendre(4, mu, p);
+    EXPECT_NEAR(p[2], 0.5 * (3 * mu * mu - 1), 1e-15);
+    EXPECT_NEAR(p[3], 0.5 * (5 * mu * mu * mu - 3 * mu), 1e-15);
+    EXPECT_NEAR(p[4], (35 * std::pow(mu, 4) - 30 * mu * mu + 3) / 8, 1e-15);
+  }
+  for (int k = 0; k < 25; ++k) EXPECT_EQ(sh_degree_of(k), int(std::sqrt(double(k))));
+}
+
+}  // namespace
+}  // namespace nebula
