@@ -24,6 +24,7 @@
 #include "axial/axial_map.h"
 #include "core/hd.h"
 #include "core/vec3.h"
+#include "illumination/chord_irradiance.h"
 #include "illumination/optical_depth_bake.h"
 #include "raycast/ray_march.h"
 #include "tables/table_lookup.h"
@@ -55,6 +56,7 @@ struct AxialMarchScene {
   float step = 1.0f;  // h, world units
   AxialSkip skip = AxialSkip::Distance;
   float min_transmittance = 1e-4f;
+  RayFootprint footprint;  // the camera's pixel width along a ray (starlight near a star)
 };
 
 // The ray in the map's frame: x(t) = x0 + t dx along the axis, and the part
@@ -268,8 +270,10 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
         dark = dark && tau_v == 0.0f;
         if (kStars && tau_v > 0.0f) {
           for (int k_star = 0; k_star < s.n_stars; ++k_star)
-            add_star_light(s, s.stars[k_star].position, s.stars[k_star].power, s.stars[k_star].depth_v[cell], pos,
-                           tau_v, m.texel, to_eye, source, &out.table_clamps);
+            add_star_light(s, s.stars[k_star].position, s.stars[k_star].power, s.stars[k_star].depth_v[cell],
+                           chord_irradiance(origin, dir, t - 0.5f * chord, t + 0.5f * chord,
+                                            s.stars[k_star].position, s.footprint),
+                           tau_v, to_eye, source, &out.table_clamps);
         }
       }
       empty = empty || dark;

@@ -26,6 +26,7 @@ AxialMarchScene assemble_axial_scene(const AxialRenderInputs& in, Place& place) 
   scene.map.distance = place.place(m.distance);
   scene.n_bands = static_cast<int>(in.bands.size());
   scene.min_transmittance = in.min_transmittance;
+  scene.footprint = in.camera.footprint();
   scene.step = effective_step(in);
   scene.skip = effective_skip(in);
   for (int b = 0; b < scene.n_bands; ++b) {

@@ -15,6 +15,14 @@ namespace nebula {
 
 enum class Projection : int { Perspective = 0, Orthographic = 1, Fisheye = 2 };
 
+// A pixel's width at distance t along its ray, in world units: width_at_eye +
+// t x spread (the marchers' starlight near a star, illumination/chord_irradiance.h).
+struct RayFootprint {
+  float width_at_eye = 0;
+  float spread = 0;
+  NEBULA_HD float width(float t) const { return width_at_eye + fmaxf(t, 0.0f) * spread; }
+};
+
 struct Camera {
   Projection projection = Projection::Perspective;
   Vec3 position;
@@ -58,6 +66,26 @@ struct Camera {
     dir = normalize(cosf(theta) * forward + (sinf(theta) * cos_phi) * right +
                     (sinf(theta) * sin_phi) * up);
     return true;
+  }
+
+  // A pixel's footprint (at the image's centre; the projections keep it
+  // nearly constant across the frame at the fields of view used).
+  NEBULA_HD RayFootprint footprint() const {
+    const float fh = float(frame_height > 0 ? frame_height : height);
+    const float per_pixel = 2.0f * pixel_span / fmaxf(fh, 1.0f);  // image units per pixel
+    if (projection == Projection::Perspective) return {0.0f, per_pixel * tan_half_fov};
+    if (projection == Projection::Orthographic) return {per_pixel * half_height, 0.0f};
+    return {0.0f, per_pixel * 0.5f * kPi};  // fisheye: 90 degrees from the centre to the rim
+  }
+
+  // The unit direction from `point` towards the eye along the ray that sees
+  // it: the camera's position (perspective, fisheye), or against the view
+  // direction (orthographic).
+  NEBULA_HD Vec3 to_eye(Vec3 point) const {
+    if (projection == Projection::Orthographic) return -forward;
+    const Vec3 d = position - point;
+    const float r = length(d);
+    return r > 0.0f ? (1.0f / r) * d : -forward;
   }
 };
 

@@ -55,6 +55,7 @@ RenderInputs level_inputs(const RenderInputs& in, const PyramidLevelData& level,
   RenderInputs out = in;
   out.progress = nullptr;
   out.density = &level.density;
+  out.diffuse = nullptr;  // the pyramid is the other way to add light between voxels
   for (size_t b = 0; b < in.bands.size(); ++b)
     out.bands[b].emission = level.emission[b].empty() ? nullptr : &level.emission[b];
   for (size_t k = 0; k < in.stars.size(); ++k) out.stars[k].depth_v = &level.depth[k];
