@@ -29,6 +29,26 @@ void print_headline(const RunReport& r) {
   std::printf(", %s\n", to_string(r.backend));
 }
 
+// Light scattered between voxels: the diffuse field's bake, or the pyramid's levels.
+void print_multiple_scattering(const RunReport& r) {
+  const DiffuseReport& d = r.diffuse;
+  if (d.done) {
+    std::printf("  diffuse field (light scattered between voxels): %zu band(s) x %llu photons, harmonics to degree %d "
+                "on %dx%dx%d cells of %d voxel(s); %.3g s (photon passes %.3g s); noise, relative L2 of its l = 0 part:",
+                d.bands, (unsigned long long)d.photons_per_band, d.order, d.cells.nx, d.cells.ny, d.cells.nz,
+                d.voxels_per_cell, d.wall_seconds, d.seconds);
+    for (size_t b = 0; b < d.noise.size() && b < r.bands.size(); ++b)
+      if (d.noise[b] >= 0) std::printf(" %s %.2g%%", r.bands[b].name.c_str(), 100 * d.noise[b]);
+    std::printf("; memory %.3g MiB kept, %.3g MiB while baking%s\n", d.field_bytes / 1048576.0,
+                d.work_bytes / 1048576.0, d.capped ? " (some photons stopped at the order cap)" : "");
+  } else if (r.multiple_scattering == "diffuse") {
+    std::printf("  diffuse field: none (no scattering band or no star)\n");
+  } else if (r.multiple_scattering == "none") {
+    std::printf("  light scattered between voxels: left out (render.multiple_scattering = \"none\")\n");
+  }
+  if (r.pyramid.size() <= 1 && r.multiple_scattering == "pyramid") std::printf("  pyramid levels: none\n");
+}
+
 void print_computed(const RunReport& r) {
   std::printf("computed, and why:\n");
   for (const BandReport& b : r.bands)
@@ -56,7 +76,7 @@ void print_computed(const RunReport& r) {
     return;
   }
   std::printf("  emission: %s\n", r.emission ? "per band grid" : "none in the scene");
-  if (r.pyramid.size() <= 1) std::printf("  pyramid levels: none\n");
+  print_multiple_scattering(r);
   for (size_t j = 1; j < r.pyramid.size(); ++j) {
     const PyramidLevelReport& p = r.pyramid[j];
     std::printf("  pyramid level %d: grid %dx%dx%d (voxel %g pc), image %dx%d; build %.3f s, bake %.3f s, render %.3f s, "

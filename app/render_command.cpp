@@ -27,6 +27,7 @@ void run_render(const Options& o) {
   if (o.levels < -1) throw Error("--levels: must be 0 or more");
   Scene scene = load_scene_options("render", o.scene);
   if (o.levels >= 0) scene.pyramid_levels = o.levels;
+  if (o.levels > 0) scene.multiple_scattering = MultipleScattering::Pyramid;  // levels are the pyramid's
   const std::string out = o.out.empty() ? scene.output : o.out;
   check_image_output("-o", out, o.force);
   RenderOptions options;
@@ -55,7 +56,8 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--smooth", o->smooth, "smooth display mode: trilinear fields at this step in voxels (0: exact)")
       ->capture_default_str();
   cmd->add_option("--levels", o->levels,
-                  "coarser pyramid levels for wide-range multiple scattering (default: the scene's render.levels, 0)");
+                  "multiple scattering by the 2005 paper's resolution pyramid with this many coarser levels, instead "
+                  "of the diffuse field (default: the scene's render.levels, 0)");
   cmd->add_option("--table-photons", o->table_photons, "photons per row for tables generated on first use")
       ->capture_default_str();
   cmd->add_flag("--force", o->force, "overwrite an existing output");

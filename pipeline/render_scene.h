@@ -11,6 +11,7 @@
 
 #include "core/backend.h"
 #include "core/image.h"
+#include "diffuse/diffuse_field.h"
 #include "illumination/optical_depth_bake.h"
 #include "imageio/image_output.h"
 #include "multires/pyramid_render.h"
@@ -35,21 +36,23 @@ struct RenderOutput {
   RunReport report;
 };
 
-// The fast renderer on a scene: its 3D grid with render.levels pyramid levels,
-// or its axial map. Validates the scene first. Errors: Error naming the scene
-// file and key, or ParameterError for "render.levels" (more levels than the
-// grid allows) and "smooth_step".
+// The fast renderer on a scene: its 3D grid, with the light scattered between
+// voxels as the scene asks (render.multiple_scattering: the diffuse field, or
+// render.levels pyramid levels, or none), or its axial map. Validates the
+// scene first. Errors: Error naming the scene file and key, or ParameterError
+// for "render.levels" (more levels than the grid allows) and "smooth_step".
 RenderOutput render_scene(const Scene& scene, const RenderOptions& options);
 
 // The view-independent part of a grid render (bands, tables, star bakes, the
-// pyramid's coarse levels): a new camera re-renders from it with none of that
-// work done again. `scene` must outlive it.
+// diffuse field or the pyramid's coarse levels): a new camera re-renders from
+// it with none of that work done again. `scene` must outlive it.
 struct PreparedGrid {
   const Scene* scene = nullptr;
   RenderOptions options;
   SceneBands bands;
   BandTables tables;
   BakeResult bake;
+  DiffuseField diffuse;  // baked when the scene asks for the diffuse field and something scatters
   PreparedPyramid pyramid;
   RenderInputs inputs;  // everything but the camera and exposure
   RunReport report;     // the work so far

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "diffuse/diffuse_bake.h"
 #include "montecarlo/table_conversion.h"
 #include "scene/scene_file.h"
 #include "scene/test_files.h"
@@ -51,6 +52,20 @@ TEST_F(RenderScene, IsTheRenderersImageOnItsInputs) {
   in.density = &s.density;
   for (size_t b = 0; b < 3; ++b) in.bands.push_back(RenderBand{sb.bands[b], tables.per_band[b].get(), nullptr});
   in.stars.push_back(BakedStar{sb.stars[0], &bake.tau_v[0]});
+  std::vector<DiffuseBand> diffuse_bands;
+  for (size_t b = 0; b < 3; ++b) {
+    DiffuseBand d;
+    static_cast<Band&>(d) = sb.bands[b];
+    d.table = tables.per_band[b].get();
+    diffuse_bands.push_back(d);
+  }
+  DiffuseBakeOptions diffuse;
+  diffuse.degree = s.diffuse.order;
+  diffuse.cells = s.diffuse.cells;
+  diffuse.photons = s.diffuse.photons;
+  diffuse.seed = s.diffuse.seed;
+  const DiffuseField field = bake_diffuse(s.density, diffuse_bands, sb.stars, diffuse, Backend::Cpu);
+  in.diffuse = &field;
   in.camera = make_camera(s.camera);
   in.exposure = 0.02f;
   const Image expected = render_cpu(in, nullptr);
@@ -62,6 +77,11 @@ TEST_F(RenderScene, IsTheRenderersImageOnItsInputs) {
 
   const RunReport& r = out.report;
   EXPECT_EQ(r.renderer, "grid");
+  EXPECT_EQ(r.multiple_scattering, "diffuse");
+  EXPECT_TRUE(r.diffuse.done);
+  EXPECT_EQ(r.diffuse.bands, 3u);
+  EXPECT_EQ(r.diffuse.photons_per_band, s.diffuse.photons);
+  for (double noise : r.diffuse.noise) EXPECT_GT(noise, 0.0);
   EXPECT_EQ(r.mode, "exact");
   EXPECT_EQ(r.width, 20);
   EXPECT_EQ(r.height, 16);
@@ -104,6 +124,7 @@ TEST_F(RenderScene, ABandsTableFileChangesThatBandOnly) {
 
 TEST_F(RenderScene, ErrorsNameTheKeyOrTheField) {
   Scene s = scene();
+  s.multiple_scattering = MultipleScattering::Pyramid;
   s.pyramid_levels = 9;  // a 16^3 grid allows 3
   try {
     render_scene(s, options());
@@ -113,6 +134,7 @@ TEST_F(RenderScene, ErrorsNameTheKeyOrTheField) {
     EXPECT_NE(std::string(e.what()).find("9 exceeds the 3"), std::string::npos) << e.what();
   }
   s.pyramid_levels = 0;
+  s.multiple_scattering = MultipleScattering::Diffuse;
   RenderOptions o = options();
   o.smooth_step = 1e-4f;
   try {
@@ -133,6 +155,7 @@ TEST_F(RenderScene, ErrorsNameTheKeyOrTheField) {
 
 TEST_F(RenderScene, PyramidLevelsAreReported) {
   const Scene s = scene("[render]\nlevels = 2\n");
+  EXPECT_EQ(s.multiple_scattering, MultipleScattering::Pyramid);  // levels ask for the pyramid
   const RenderOutput out = render_scene(s, options());
   ASSERT_EQ(out.report.pyramid.size(), 3u);
   EXPECT_EQ(out.report.pyramid[2].shape.nx, 4);

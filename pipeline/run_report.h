@@ -41,6 +41,21 @@ struct BakeReport {
   double seconds = 0;
 };
 
+// The diffuse field's bake (diffuse/diffuse_bake.h).
+struct DiffuseReport {
+  bool done = false;
+  int order = 0;
+  GridShape cells;             // the field's cells
+  int voxels_per_cell = 1;     // along each axis
+  uint64_t photons_per_band = 0;
+  size_t bands = 0;            // bands baked (those that scatter)
+  double seconds = 0;          // the photon passes (CUDA events on the GPU)
+  double wall_seconds = 0;     // the whole bake, responses included
+  std::vector<double> noise;   // per scene band: relative L2 noise of the field's l = 0 part; -1: no field
+  uint64_t collisions = 0, crossings = 0, capped = 0;
+  size_t field_bytes = 0, work_bytes = 0;
+};
+
 struct AxialMapReport {
   std::string source;   // synthetic, file or image, with its name
   int nx = 0, nr = 0;
@@ -78,6 +93,8 @@ struct RunReport {
   std::vector<BandReport> bands;
   std::vector<TableReport> tables;
   BakeReport bake;
+  std::string multiple_scattering;  // "diffuse", "pyramid" or "none"
+  DiffuseReport diffuse;
   bool emission = false;
   std::vector<PyramidLevelReport> pyramid;  // grid renders: level 0 first
   std::optional<AxialMapReport> axial;

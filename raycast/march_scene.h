@@ -25,6 +25,16 @@ const StarView* place_star_views(const std::vector<BakedStar>& stars, int n_band
   return place.keep(std::move(views));
 }
 
+// A kernel view of a diffuse field with its arrays placed.
+template <class Place>
+DiffuseView place_diffuse(const DiffuseField& field, Place& place) {
+  DiffuseView v = field.view();
+  v.packed = place.place(field.packed);
+  for (size_t b = 0; b < field.coeffs.size() && b < size_t(kMaxBands); ++b)
+    if (!field.coeffs[b].empty()) v.response[b] = place.place(field.response[b]);
+  return v;
+}
+
 // Validates `in`, then builds the scene march_ray reads from placed arrays.
 template <class Place>
 MarchScene assemble_march_scene(const RenderInputs& in, Place& place) {
@@ -33,6 +43,7 @@ MarchScene assemble_march_scene(const RenderInputs& in, Place& place) {
   scene.density = {in.density->shape, place.place(in.density->tau_v)};
   scene.n_bands = static_cast<int>(in.bands.size());
   scene.min_transmittance = in.min_transmittance;
+  scene.footprint = in.camera.footprint();
   for (int b = 0; b < scene.n_bands; ++b) {
     const RenderBand& band = in.bands[size_t(b)];
     scene.extinction_ratio[b] = band.extinction_ratio;
@@ -42,6 +53,10 @@ MarchScene assemble_march_scene(const RenderInputs& in, Place& place) {
   }
   scene.stars = place_star_views(in.stars, scene.n_bands, place);
   scene.n_stars = static_cast<int>(in.stars.size());
+  if (in.diffuse) {
+    scene.has_diffuse = true;
+    scene.diffuse = place_diffuse(*in.diffuse, place);
+  }
   return scene;
 }
 

@@ -9,6 +9,8 @@
 #include "core/dda.h"
 #include "core/grid.h"
 #include "core/hd.h"
+#include "diffuse/diffuse_field.h"
+#include "illumination/chord_irradiance.h"
 #include "illumination/optical_depth_bake.h"
 #include "tables/table_lookup.h"
 
@@ -33,6 +35,13 @@ struct MarchScene {
   const StarView* stars = nullptr;
   int n_stars = 0;
   float min_transmittance = 1e-4f;    // rays stop once every band is below this
+  RayFootprint footprint;             // the camera's pixel width along a ray (starlight near a star)
+  bool has_diffuse = false;           // light scattered between voxels (diffuse/), per band where baked
+  DiffuseView diffuse;
+  // The field's light each voxel scatters towards this view's eye, per band
+  // (null where the band has no field): raycast/diffuse_light.h fills it
+  // before the march.
+  const float* diffuse_light[kMaxBands] = {};
 };
 
 struct RayResult {
@@ -52,15 +61,16 @@ NEBULA_HD void store_radiance(const RayResult& r, int n_bands, float exposure, f
     if (b < n_bands) pixels[b * plane + size_t(y) * width + x] = exposure * r.radiance[b];
 }
 
-// One star's light that dust at `pos` (V-band depth tau_v per cell edge
-// `edge`) sends towards the eye per band, per unit of chord / edge, added to
-// `source`: E P(tau_sct, theta). depth_v is the star's baked V-band depth to
-// the cell. Shared by the 3D marcher and the axial one (Scene: n_bands,
-// extinction_ratio, albedo, table).
+// One star's light that dust of V-band depth tau_v per cell sends towards the
+// eye per band, per unit of chord / edge, added to `source`: E P(tau_sct,
+// theta), with E from the star's mean 1 / r^2 over the cell's chord and theta
+// at the chord's point `at` (illumination/chord_irradiance.h). depth_v is the
+// star's baked V-band depth to the cell. Shared by the 3D marcher and the
+// axial one (Scene: n_bands, extinction_ratio, albedo, table).
 template <class Scene>
-NEBULA_HD void add_star_light(const Scene& s, Vec3 star, const float* power, float depth_v, Vec3 pos, float tau_v,
-                              float edge, Vec3 to_eye, float* source, int* clamps) {
-  const Vec3 d = pos - star;
+NEBULA_HD void add_star_light(const Scene& s, Vec3 star, const float* power, float depth_v, const ChordIrradiance& at,
+                              float tau_v, Vec3 to_eye, float* source, int* clamps) {
+  const Vec3 d = at.point - star;
   const float r = length(d);
   // theta: between the light's direction (star to dust) and the way to the eye.
   const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
@@ -76,21 +86,22 @@ NEBULA_HD void add_star_light(const Scene& s, Vec3 star, const float* power, flo
       u_from = b;
     }
     const float tau_b = tau_v * s.extinction_ratio[b];
-    const float e = star_irradiance(power[b], r, edge, depth_v * s.extinction_ratio[b]);
+    const float e = power[b] * kInv4Pi * at.inv_r2 * expf(-depth_v * s.extinction_ratio[b]);
     source[b] += e * s.table[b].lookup_at(s.albedo[b] * tau_b, u, clamps);
   }
 }
 
-// Light that dust at `pos` (V-band depth per voxel edge tau_v) sends towards
-// the eye per band, per unit of chord / l: sum over stars of E_s P(tau_sct,
-// theta_s). depth_of(k) is star k's baked V-band depth to this point.
-template <class DepthOf>
-NEBULA_HD void scattered_source(const MarchScene& s, Vec3 pos, float tau_v, Vec3 to_eye,
+// Light that dust of V-band depth per voxel edge tau_v sends towards the eye
+// per band, per unit of chord / l: sum over stars of E_s P(tau_sct, theta_s).
+// irradiance_of(k) is star k's ChordIrradiance over the chord (or at the
+// sample), depth_of(k) its baked V-band depth to the voxel.
+template <class IrradianceOf, class DepthOf>
+NEBULA_HD void scattered_source(const MarchScene& s, float tau_v, Vec3 to_eye, IrradianceOf&& irradiance_of,
                                 DepthOf&& depth_of, float* source, int* clamps) {
   if (!(tau_v > 0.0f)) return;
   for (int k = 0; k < s.n_stars; ++k)
-    add_star_light(s, s.stars[k].position, s.stars[k].power, depth_of(k), pos, tau_v, s.density.shape.voxel, to_eye,
-                   source, clamps);
+    add_star_light(s, s.stars[k].position, s.stars[k].power, depth_of(k), irradiance_of(k), tau_v, to_eye, source,
+                   clamps);
 }
 
 // A cell-centred field at `pos`: trilinear (clamped at the grid's edge) or
@@ -136,8 +147,11 @@ struct MarchMode {
 // enters that voxel (DESIGN.md: P holds the voxel's own extinction, so a
 // sub-voxel step must not darken its voxel again); the smooth mode spreads
 // the voxel's chord over samples of the interpolated fields inside it.
-template <bool kSmooth>
-NEBULA_HD RayResult march_ray_in_mode(const MarchScene& s, Vec3 origin, Vec3 dir, MarchMode mode) {
+// kDiffuse: the scene has a diffuse field, its light per voxel already
+// evaluated for this view (raycast/diffuse_light.h): it adds to the voxel's
+// source as emission does, and its forward peak to the voxel's transmittance.
+template <bool kSmooth, bool kDiffuse>
+NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchMode mode) {
   RayResult out{};
   for (int b = 0; b < kMaxBands; ++b) out.transmittance[b] = 1.0f;
   const GridShape& g = s.density.shape;
@@ -151,9 +165,10 @@ NEBULA_HD RayResult march_ray_in_mode(const MarchScene& s, Vec3 origin, Vec3 dir
   const float step = mode.step_voxels * g.voxel;
   const Vec3 to_eye = -dir;
   float t = t_enter;  // where the current voxel begins along the ray
-  traverse_segment_cells(g, origin, origin + far * dir, [&](int x, int y, int z, size_t cell, float chord) -> bool {
+  traverse_segment_cells(g, origin, origin + far * dir, [&](int, int, int, size_t cell, float chord) -> bool {
     const float tau_v = s.density.tau_v[cell];
     float source[kMaxBands] = {};
+    float peak[kMaxBands] = {};  // the diffuse response's forward peak (kDiffuse)
     if constexpr (kSmooth) {
       // Samples at t_enter + (k + 1/2) step that fall inside this voxel.
       const float first = ceilf((t - t_enter) / step - 0.5f);
@@ -161,14 +176,31 @@ NEBULA_HD RayResult march_ray_in_mode(const MarchScene& s, Vec3 origin, Vec3 dir
         const float ts = t_enter + (k + 0.5f) * step;
         if (ts >= t + chord || ts >= t_exit) break;
         // Trilinear fields are smooth, so is their geometry; voxel values keep
-        // the voxel centre's, as the exact traversal does.
-        const Vec3 pos = mode.trilinear ? origin + ts * dir : g.centre(x, y, z);
+        // the chord's geometry (its starlight over the chord), as the exact
+        // traversal does.
+        const Vec3 pos = mode.trilinear ? origin + ts * dir : origin + (t + 0.5f * chord) * dir;
         float local[kMaxBands] = {};
         for (int b = 0; b < s.n_bands; ++b)
           local[b] = s.emission[b] ? sample_field(g, s.emission[b], pos, mode.trilinear) : 0.0f;
-        scattered_source(s, pos, sample_field(g, s.density.tau_v, pos, mode.trilinear), to_eye,
-                         [&](int k_star) { return sample_field(g, s.stars[k_star].depth_v, pos, mode.trilinear); },
-                         local, &out.table_clamps);
+        const float tau_sample = sample_field(g, s.density.tau_v, pos, mode.trilinear);
+        scattered_source(
+            s, tau_sample, to_eye,
+            [&](int k_star) {
+              const Vec3 star = s.stars[k_star].position;
+              return mode.trilinear ? point_irradiance(pos, star, s.footprint.width(ts))
+                                    : chord_irradiance(origin, dir, t, t + chord, star, s.footprint);
+            },
+            [&](int k_star) { return sample_field(g, s.stars[k_star].depth_v, pos, mode.trilinear); }, local,
+            &out.table_clamps);
+        if constexpr (kDiffuse) {
+          if (tau_sample > 0.0f)
+            for (int b = 0; b < s.n_bands; ++b)
+              if (s.diffuse_light[b]) {
+                local[b] += sample_field(g, s.diffuse_light[b], pos, mode.trilinear);
+                peak[b] += s.diffuse.peak(b, s.albedo[b] * tau_sample * s.extinction_ratio[b]) * step /
+                           fmaxf(chord, 1e-30f);
+              }
+        }
         for (int b = 0; b < s.n_bands; ++b) source[b] += local[b] * step / fmaxf(chord, 1e-30f);
       }
     } else {
@@ -176,9 +208,20 @@ NEBULA_HD RayResult march_ray_in_mode(const MarchScene& s, Vec3 origin, Vec3 dir
       for (int b = 0; b < kMaxBands; ++b)
         if (b < s.n_bands) source[b] = s.emission[b] ? s.emission[b][cell] : 0.0f;
       if (tau_v > 0.0f && s.n_stars > 0) {
-        scattered_source(s, g.centre(x, y, z), tau_v, to_eye,
-                         [&](int k_star) { return s.stars[k_star].depth_v[cell]; }, source,
-                         &out.table_clamps);
+        scattered_source(
+            s, tau_v, to_eye,
+            [&](int k_star) { return chord_irradiance(origin, dir, t, t + chord, s.stars[k_star].position, s.footprint); },
+            [&](int k_star) { return s.stars[k_star].depth_v[cell]; }, source, &out.table_clamps);
+      }
+      if constexpr (kDiffuse) {
+        if (tau_v > 0.0f) {
+          NEBULA_UNROLL
+          for (int b = 0; b < kMaxBands; ++b)
+            if (b < s.n_bands && s.diffuse_light[b]) {
+              source[b] += s.diffuse_light[b][cell];
+              peak[b] = s.diffuse.peak(b, s.albedo[b] * tau_v * s.extinction_ratio[b]);
+            }
+        }
       }
     }
     t += chord;
@@ -188,7 +231,10 @@ NEBULA_HD RayResult march_ray_in_mode(const MarchScene& s, Vec3 origin, Vec3 dir
     for (int b = 0; b < kMaxBands; ++b) {
       if (b >= s.n_bands) break;
       out.radiance[b] += out.transmittance[b] * source[b] * fraction;
-      out.transmittance[b] *= expf(-tau_v * s.extinction_ratio[b] * fraction);
+      if constexpr (kDiffuse)
+        out.transmittance[b] *= fminf(1.0f, expf(-tau_v * s.extinction_ratio[b] * fraction) + peak[b] * fraction);
+      else
+        out.transmittance[b] *= expf(-tau_v * s.extinction_ratio[b] * fraction);
       visible = visible || out.transmittance[b] >= s.min_transmittance;
     }
     return visible;
@@ -196,11 +242,17 @@ NEBULA_HD RayResult march_ray_in_mode(const MarchScene& s, Vec3 origin, Vec3 dir
   return out;
 }
 
-// The exact traversal and the smooth mode are compiled apart, so the
-// reference path carries none of the sampling code (registers, branches).
-NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchMode mode = {}) {
-  return mode.step_voxels > 0.0f ? march_ray_in_mode<true>(s, origin, dir, mode)
-                                 : march_ray_in_mode<false>(s, origin, dir, mode);
+// Calls f(smooth, diffuse) with std::bool_constant values: the one place that
+// turns the scene's mode into march_ray's template arguments, for the CPU loop
+// and the CUDA launch. The exact traversal, the smooth mode and the diffuse
+// field's terms are compiled apart, so the reference path carries none of the
+// others' code (registers, branches).
+template <class F>
+decltype(auto) dispatch_march(const MarchScene& s, MarchMode mode, F&& f) {
+  auto with_smooth = [&](auto diffuse) -> decltype(auto) {
+    return mode.step_voxels > 0.0f ? f(std::true_type{}, diffuse) : f(std::false_type{}, diffuse);
+  };
+  return s.has_diffuse ? with_smooth(std::true_type{}) : with_smooth(std::false_type{});
 }
 
 }  // namespace nebula

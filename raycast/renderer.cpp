@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/placement.h"
 #include "core/progress.h"
+#include "raycast/diffuse_light.h"
 #include "raycast/march_scene.h"
 
 namespace nebula {
@@ -30,26 +31,58 @@ void validate(const RenderInputs& in) {
     if (s.power.size() != in.bands.size()) throw Error("render: a star lacks band powers");
     if (!s.depth_v || s.depth_v->size() != voxels) throw Error("render: a star has no baked depth");
   }
+  if (const DiffuseField* f = in.diffuse) {
+    const GridShape& g = in.density->shape;
+    const int edge = 1 << f->shift;
+    if (f->coeffs.size() != in.bands.size() || f->cells.nx != (g.nx + edge - 1) / edge ||
+        f->cells.ny != (g.ny + edge - 1) / edge || f->cells.nz != (g.nz + edge - 1) / edge)
+      throw Error("render: the diffuse field was baked for another grid or other bands");
+    if (f->packed.size() != f->cells.count() * size_t(f->n_coeffs()) * 4)
+      throw Error("render: the diffuse field is not packed (DiffuseField::pack)");
+    for (size_t b = 0; b < in.bands.size(); ++b)
+      if (!f->coeffs[b].empty() &&
+          (f->coeffs[b].size() != f->cells.count() * size_t(f->n_coeffs()) || f->response[b].empty()))
+        throw Error("render: the diffuse field of band " + in.bands[b].name + " is malformed");
+  }
 }
 
 Image render_cpu(const RenderInputs& in, RenderStats* stats) {
   HostPlacement host;
-  const MarchScene scene = assemble_march_scene(in, host);
+  MarchScene scene = assemble_march_scene(in, host);
   Image image(in.camera.width, in.camera.height, band_names(in.bands));
   std::atomic<uint64_t> clamps{0};
   const auto start = std::chrono::steady_clock::now();
-  tbb::parallel_for(tbb::blocked_range<int>(0, in.camera.height), [&](const auto& rows) {
-    uint64_t local_clamps = 0;
-    for (int y = rows.begin(); y != rows.end(); ++y)
-      for (int x = 0; x < in.camera.width; ++x) {
-        Vec3 origin, dir;
-        if (!in.camera.ray(x, y, origin, dir)) continue;
-        const RayResult r = march_ray(scene, origin, dir, in.mode);
-        store_radiance(r, scene.n_bands, in.exposure, image.pixels.data(), image.width, image.height, x, y);
-        local_clamps += r.table_clamps;
+  std::vector<std::vector<float>> light(kMaxBands);
+  if (scene.has_diffuse) {
+    const GridShape& g = scene.density.shape;
+    DiffuseLightPlanes planes;
+    for (int b = 0; b < scene.n_bands; ++b)
+      if (scene.diffuse.has[b]) {
+        light[b].assign(g.count(), 0.0f);
+        planes.band[b] = light[b].data();
+        scene.diffuse_light[b] = planes.band[b];
       }
-    clamps += local_clamps;
-    if (in.progress) in.progress->add(rows.size());
+    dispatch_diffuse_degree(scene.diffuse.degree, [&](auto degree) {
+      tbb::parallel_for(tbb::blocked_range<int>(0, g.ny * g.nz), [&](const auto& rows) {
+        for (int r = rows.begin(); r != rows.end(); ++r)
+          diffuse_light_row<degree()>(scene, in.camera, r % g.ny, r / g.ny, 0, g.nx, planes);
+      });
+    });
+  }
+  dispatch_march(scene, in.mode, [&](auto smooth, auto diffuse) {
+    tbb::parallel_for(tbb::blocked_range<int>(0, in.camera.height), [&](const auto& rows) {
+      uint64_t local_clamps = 0;
+      for (int y = rows.begin(); y != rows.end(); ++y)
+        for (int x = 0; x < in.camera.width; ++x) {
+          Vec3 origin, dir;
+          if (!in.camera.ray(x, y, origin, dir)) continue;
+          const RayResult r = march_ray<smooth(), diffuse()>(scene, origin, dir, in.mode);
+          store_radiance(r, scene.n_bands, in.exposure, image.pixels.data(), image.width, image.height, x, y);
+          local_clamps += r.table_clamps;
+        }
+      clamps += local_clamps;
+      if (in.progress) in.progress->add(rows.size());
+    });
   });
   if (stats) {
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

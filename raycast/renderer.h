@@ -10,6 +10,7 @@
 #include "core/camera.h"
 #include "core/grid.h"
 #include "core/image.h"
+#include "diffuse/diffuse_field.h"
 #include "raycast/ray_march.h"
 #include "tables/scattering_table.h"
 
@@ -28,6 +29,10 @@ struct RenderInputs {
   const DensityGrid* density = nullptr;
   std::vector<RenderBand> bands;
   std::vector<BakedStar> stars;  // depth_v: the baked V-band depth per voxel
+  // Light scattered between voxels (diffuse/diffuse_bake.h), baked for this
+  // grid and these bands; null: none (single scattering and each voxel's own
+  // multiple scattering only).
+  const DiffuseField* diffuse = nullptr;
   Camera camera;
   float exposure = 1.0f;
   float min_transmittance = 1e-4f;

@@ -3,10 +3,14 @@
 // uploaded), then one thread per pixel runs the shared march_ray.
 #include <cuda_runtime.h>
 
+#include <memory>
+#include <vector>
+
 #include "core/cuda_check.h"
 #include "core/cuda_timer.h"
 #include "core/device_array.h"
 #include "core/device_placement.h"
+#include "raycast/diffuse_light.h"
 #include "raycast/march_scene.h"
 #include "raycast/renderer.h"
 
@@ -16,20 +20,33 @@ namespace {
 // Blocks of 256 threads per SM the compiler must fit in registers (exact
 // mode). With the band loops unrolled (per-band arrays in registers, not on
 // the stack) and at most 64 registers: 4.69 ms against 5.79 ms per frame on an
-// H100 (docs/performance.md). The smooth mode keeps its 116 registers.
+// H100 (docs/performance.md); with the diffuse field's terms, 6.72 ms
+// against 6.96 ms at 80 registers. The smooth mode keeps its 116 registers.
 #ifndef NEBULA_RENDER_MIN_BLOCKS
 #define NEBULA_RENDER_MIN_BLOCKS 4
 #endif
 
-template <bool kSmooth>
-__global__ void __launch_bounds__(256, kSmooth ? 2 : NEBULA_RENDER_MIN_BLOCKS) render_kernel(MarchScene scene, Camera camera, MarchMode mode, float exposure,
-                              float* pixels, unsigned long long* clamps) {
+// One thread per voxel: the diffuse field's light towards this view's eye
+// (raycast/diffuse_light.h).
+template <int kDeg>
+__global__ void diffuse_light_kernel(MarchScene scene, Camera camera, DiffuseLightPlanes out) {
+  const GridShape& g = scene.density.shape;
+  const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (i >= g.count()) return;
+  const int x = int(i % size_t(g.nx)), y = int(i / size_t(g.nx) % size_t(g.ny)), z = int(i / (size_t(g.nx) * g.ny));
+  diffuse_light_row<kDeg>(scene, camera, y, z, x, x + 1, out);
+}
+
+template <bool kSmooth, bool kDiffuse>
+__global__ void __launch_bounds__(256, kSmooth ? 2 : NEBULA_RENDER_MIN_BLOCKS)
+    render_kernel(MarchScene scene, Camera camera, MarchMode mode, float exposure, float* pixels,
+                  unsigned long long* clamps) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x;
   const int y = blockIdx.y * blockDim.y + threadIdx.y;
   if (x >= camera.width || y >= camera.height) return;
   Vec3 origin, dir;
   if (!camera.ray(x, y, origin, dir)) return;
-  const RayResult r = march_ray_in_mode<kSmooth>(scene, origin, dir, mode);
+  const RayResult r = march_ray<kSmooth, kDiffuse>(scene, origin, dir, mode);
   store_radiance(r, scene.n_bands, exposure, pixels, camera.width, camera.height, x, y);
   if (r.table_clamps) atomicAdd(clamps, static_cast<unsigned long long>(r.table_clamps));
 }
@@ -38,14 +55,31 @@ __global__ void __launch_bounds__(256, kSmooth ? 2 : NEBULA_RENDER_MIN_BLOCKS) r
 
 double render_cuda_to_device(const RenderInputs& in, float* pixels, unsigned long long* clamps) {
   DevicePlacement device;
-  const MarchScene scene = assemble_march_scene(in, device);
+  MarchScene scene = assemble_march_scene(in, device);
   const dim3 block(16, 16), grid((in.camera.width + 15) / 16, (in.camera.height + 15) / 16);
+  // The diffuse field's light for this view, per band with a field.
+  std::vector<std::unique_ptr<DeviceArray<float>>> light;
+  DiffuseLightPlanes planes;
+  const size_t count = scene.density.shape.count();
+  if (scene.has_diffuse)
+    for (int b = 0; b < scene.n_bands; ++b)
+      if (scene.diffuse.has[b]) {
+        light.push_back(std::make_unique<DeviceArray<float>>(count));
+        planes.band[b] = light.back()->get();
+        scene.diffuse_light[b] = planes.band[b];
+      }
   CudaEventTimer timer;
-  // One kernel per mode: the exact one carries none of the smooth mode's code.
-  if (in.mode.step_voxels > 0.0f)
-    render_kernel<true><<<grid, block>>>(scene, in.camera, in.mode, in.exposure, pixels, clamps);
-  else
-    render_kernel<false><<<grid, block>>>(scene, in.camera, in.mode, in.exposure, pixels, clamps);
+  if (scene.has_diffuse) {
+    const unsigned blocks = static_cast<unsigned>((count + 255) / 256);
+    dispatch_diffuse_degree(scene.diffuse.degree, [&](auto degree) {
+      diffuse_light_kernel<degree()><<<blocks, 256>>>(scene, in.camera, planes);
+    });
+    NEBULA_CUDA_CHECK(cudaGetLastError());
+  }
+  // One kernel per mode (raycast/ray_march.h, dispatch_march).
+  dispatch_march(scene, in.mode, [&](auto smooth, auto diffuse) {
+    render_kernel<smooth(), diffuse()><<<grid, block>>>(scene, in.camera, in.mode, in.exposure, pixels, clamps);
+  });
   NEBULA_CUDA_CHECK(cudaGetLastError());
   return timer.seconds();
 }

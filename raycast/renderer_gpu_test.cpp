@@ -4,6 +4,7 @@
 
 #include "core/gpu.h"
 #include "core/philox.h"
+#include "diffuse/diffuse_bake.h"
 #include "raycast/renderer.h"
 #include "raycast/test_scenes.h"
 
@@ -50,6 +51,38 @@ TEST(RendererGpu, AgreesWithTheCpu) {
     }
     EXPECT_EQ(cpu_stats.table_clamps, gpu_stats.table_clamps);
   }
+}
+
+// With a diffuse field: the same marcher on both backends (the field's lookups
+// and the delta-M peak's transmittance included).
+TEST(RendererGpu, DiffuseFieldAgreesWithTheCpu) {
+  std::string why;
+  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  testing::OneStarScene s;
+  s.grid = testing::noise_cube(40, 0.4f, 11);
+  s.table = testing::thin_table(0.6, 72, 10.0);
+  s.finish({0.1f, 0.2f, -0.1f}, 100.0f, 0.6f, testing::oblique_camera(96, 64));
+  DiffuseBand band;
+  static_cast<Band&>(band) = s.inputs.bands[0];
+  band.table = &s.table;
+  DiffuseBakeOptions o;
+  o.degree = kMaxDiffuseDegree;
+  o.cells = 20;
+  o.photons = 100000;
+  const DiffuseField field = bake_diffuse(s.grid, {band}, {s.inputs.stars[0]}, o, Backend::Cpu);
+  s.inputs.diffuse = &field;
+  const Image cpu = render_cpu(s.inputs, nullptr);
+  const Image gpu = render_cuda(s.inputs, nullptr);
+  double peak = 0, worst = 0, mean = 0;
+  for (size_t i = 0; i < cpu.pixels.size(); ++i) {
+    peak = std::max(peak, double(cpu.pixels[i]));
+    worst = std::max(worst, double(std::fabs(cpu.pixels[i] - gpu.pixels[i])));
+    mean += std::fabs(cpu.pixels[i] - gpu.pixels[i]) / cpu.pixels.size();
+  }
+  std::printf("diffuse: largest CPU-GPU difference %.3g of the peak %.3g, mean %.3g of it\n", worst / peak, peak,
+              mean / peak);
+  EXPECT_GT(peak, 0.0);
+  EXPECT_LT(worst, 1e-4 * peak);
 }
 
 }  // namespace

@@ -12,6 +12,23 @@
 
 namespace nebula {
 
+const char* to_string(MultipleScattering mode) {
+  switch (mode) {
+    case MultipleScattering::Diffuse: return "diffuse";
+    case MultipleScattering::Pyramid: return "pyramid";
+    default: return "none";
+  }
+}
+
+bool parse_multiple_scattering(const std::string& name, MultipleScattering& out) {
+  for (MultipleScattering m : {MultipleScattering::Diffuse, MultipleScattering::Pyramid, MultipleScattering::None})
+    if (name == to_string(m)) {
+      out = m;
+      return true;
+    }
+  return false;
+}
+
 CameraSettings scene_camera_defaults() {
   CameraSettings c;
   c.position = c.look_at = Vec3{0, 0, 0};
@@ -107,6 +124,17 @@ std::optional<SceneIssue> settings_issue(const Scene& s) {
                       "is " + to_text(s.star_psf_pixels) + "; must be in (0, 1000]"};
   if (s.pyramid_levels < 0 || s.pyramid_levels > 16)
     return SceneIssue{"render.levels", "is " + std::to_string(s.pyramid_levels) + "; must be in 0..16"};
+  if (s.pyramid_levels > 0 && s.multiple_scattering != MultipleScattering::Pyramid)
+    return SceneIssue{"render.levels", "is " + std::to_string(s.pyramid_levels) +
+                                           " but render.multiple_scattering is \"" + to_string(s.multiple_scattering) +
+                                           "\": levels belong to the pyramid (set multiple_scattering = \"pyramid\")"};
+  if (s.diffuse.order < 0 || s.diffuse.order > 4)
+    return SceneIssue{"render.diffuse_order", "is " + std::to_string(s.diffuse.order) + "; must be in 0..3"};
+  if (s.diffuse.cells < 1 || s.diffuse.cells > 4096)
+    return SceneIssue{"render.diffuse_cells", "is " + std::to_string(s.diffuse.cells) + "; must be in 1..4096"};
+  if (s.diffuse.photons < 1 || s.diffuse.photons > 0xFFFFFFFFull)
+    return SceneIssue{"render.diffuse_photons",
+                      "is " + std::to_string(s.diffuse.photons) + "; must be in 1..4294967295 (per band)"};
   return std::nullopt;
 }
 

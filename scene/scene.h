@@ -7,6 +7,7 @@
 // star positions, camera); luminosity in solar luminosities; temperatures in
 // K. Rendered radiance is in L_sun pc^-2 sr^-1 per band times `exposure`, a
 // relative scale (no distance to the observer, no detector).
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -64,6 +65,22 @@ struct AxialSpec {
   double step_texels = 0.5;        // the march's step h in texels
 };
 
+// How the fast renderer adds light scattered between voxels (the tables hold
+// the scattering inside each voxel): the diffuse field baked by photons
+// (diffuse/, docs/diffuse.md), the 2005 paper's resolution pyramid
+// (docs/pyramid.md), or not at all.
+enum class MultipleScattering { Diffuse, Pyramid, None };
+const char* to_string(MultipleScattering mode);  // "diffuse", "pyramid", "none"
+bool parse_multiple_scattering(const std::string& name, MultipleScattering& out);
+
+// The diffuse field's settings ([render] diffuse_*, docs/scene.md).
+struct DiffuseSettings {
+  int order = 3;                 // harmonics' degree, 0 to 4
+  int cells = 64;                // field cells along the grid's longest axis (at least)
+  uint64_t photons = 1u << 20;   // per band
+  uint64_t seed = 1;
+};
+
 struct Scene {
   std::string path;  // the scene file as given ("demo" for demo_scene())
   std::vector<std::string> bands{"B", "V", "R"};
@@ -79,8 +96,12 @@ struct Scene {
   std::string output = "nebula.exr";  // as written; relative to the working directory
   bool draw_stars = false;
   double star_psf_pixels = 1.5;  // Gaussian sigma of a drawn star, pixels
-  // Coarser levels of the multi-resolution pyramid added to the render (2005
-  // paper, section 4.2); 0: the plain render. At most the grid allows
+  // Light scattered between voxels: by default the diffuse field; with pyramid
+  // levels (render.levels > 0) and no explicit choice, the pyramid.
+  MultipleScattering multiple_scattering = MultipleScattering::Diffuse;
+  DiffuseSettings diffuse;
+  // Coarser levels of the multi-resolution pyramid (2005 paper, section 4.2),
+  // for multiple_scattering = Pyramid; at most the grid allows
   // (multires/volume_pyramid.h), checked by the renderer.
   int pyramid_levels = 0;
 };

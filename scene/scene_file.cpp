@@ -59,7 +59,8 @@ const char* type_name(const toml::node& n) {
 // The keys of every table in a scene file.
 const std::initializer_list<std::string_view> kTopKeys = {"bands",  "density", "emission", "dust",
                                                           "stars",  "camera",  "output", "render", "axial"};
-const std::initializer_list<std::string_view> kRenderKeys = {"levels"};
+const std::initializer_list<std::string_view> kRenderKeys = {
+    "levels", "multiple_scattering", "diffuse_order", "diffuse_cells", "diffuse_photons", "diffuse_seed"};
 const std::initializer_list<std::string_view> kAxialKeys = {
     "synthetic", "file", "image", "dataset", "emission_prefix", "tau_channel", "emission_channels", "nx", "nr",
     "length_pc", "tau_scale", "emission_scale", "origin", "axis", "skip", "step_texels"};
@@ -651,6 +652,26 @@ void Parser::parse_render(const toml::table& root, Scene& scene) const {
   const toml::table& t = table_at(*n, "render");
   known_keys(t, "render", kRenderKeys);
   if (const toml::node* v = t.get("levels")) scene.pyramid_levels = small_integer(*v, "render.levels");
+  // Levels without an explicit choice ask for the pyramid, as before the diffuse field existed.
+  scene.multiple_scattering = scene.pyramid_levels > 0 ? MultipleScattering::Pyramid : MultipleScattering::Diffuse;
+  if (const toml::node* v = t.get("multiple_scattering")) {
+    const std::string mode = lower(string(*v, "render.multiple_scattering"));
+    if (!parse_multiple_scattering(mode, scene.multiple_scattering))
+      fail("render.multiple_scattering", "'" + mode + "' is not a mode (known: diffuse, pyramid, none)");
+  }
+  DiffuseSettings& d = scene.diffuse;
+  if (const toml::node* v = t.get("diffuse_order")) d.order = small_integer(*v, "render.diffuse_order");
+  if (const toml::node* v = t.get("diffuse_cells")) d.cells = small_integer(*v, "render.diffuse_cells");
+  auto count = [&](const char* name, uint64_t& out) {
+    const toml::node* v = t.get(name);
+    if (!v) return;
+    const std::string key = std::string("render.") + name;
+    const double x = number(*v, key);
+    if (!(x >= 0 && x <= 1.8e19) || x != std::floor(x)) fail(key, "must be a whole number >= 0, got " + number_text(x));
+    out = static_cast<uint64_t>(x);
+  };
+  count("diffuse_photons", d.photons);
+  count("diffuse_seed", d.seed);
 }
 
 void Parser::load_grids(const DensityPlan& density, const std::optional<EmissionPlan>& emission,

@@ -9,6 +9,6 @@ cd "$(dirname "$0")/.."
 build=${BUILD:-build-device}
 bins=("$build"/bin/nebula "$build"/bin/core_tests "$build"/bin/montecarlo_tests "$build"/bin/tables_tests
       "$build"/bin/illumination_tests "$build"/bin/raycast_tests "$build"/bin/axial_tests "$build"/bin/multires_tests
-      "$build"/bin/truth_tests "$build"/bin/pipeline_tests)
+      "$build"/bin/truth_tests "$build"/bin/pipeline_tests "$build"/bin/diffuse_tests)
 bins+=("$build"/bin/*_gpu_tests)
 ../shared/tools/device-bundle .devbundle "${bins[@]}" -- scenes

@@ -11,7 +11,7 @@ mkdir -p "$OUT"
 nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm,memory.total --format=csv | tee "$OUT/gpu.txt"
 {
   for t in "$B"/bin/*_gpu_tests; do "$t" --gtest_brief=1 || echo "FAILED: $t"; done
-  for t in core_tests montecarlo_tests tables_tests illumination_tests raycast_tests axial_tests multires_tests truth_tests pipeline_tests; do "$B/bin/$t" --gtest_brief=1 || echo "FAILED: $t"; done
+  for t in core_tests montecarlo_tests tables_tests illumination_tests raycast_tests axial_tests multires_tests truth_tests pipeline_tests diffuse_tests; do "$B/bin/$t" --gtest_brief=1 || echo "FAILED: $t"; done
 } 2>&1 | tee "$OUT/tests.log"
 "$B/bin/nebula" validate montecarlo --backend cuda --effort 4 2>&1 | tee "$OUT/validate.log"
 "$B/bin/nebula" tabulate --backend cuda -q --photons 1e6 -o "$OUT/table_a0.6_g0.6.h5" 2>&1 | tee "$OUT/tabulate.log"

@@ -1,6 +1,7 @@
 #include "validation/benchmarks.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "axial/axial_bake.h"
@@ -187,6 +188,65 @@ std::vector<RenderBenchRow> bench_render(Backend backend, int size, int width, i
     rows.push_back(row);
   }
   return rows;
+}
+
+DiffuseBench bench_diffuse(Backend backend, int size, int width, int height, int repeats, int degree, int cells,
+                           uint64_t photons) {
+  const BenchNebula nebula(backend, size, width, height);
+  const std::vector<Vec3> positions{nebula.star(0)};
+  DiffuseBench out;
+  out.backend = to_string(backend);
+  out.size = size;
+  out.width = width;
+  out.height = height;
+  out.degree = degree;
+  out.photons = photons;
+  BakeResult bake = bake_star_depths(nebula.grid, positions, backend);  // warm-up
+  const RenderInputs in = nebula.inputs(positions, bake);
+  std::vector<DiffuseBand> bands;
+  for (const RenderBand& b : in.bands) {
+    DiffuseBand d;
+    static_cast<Band&>(d) = b;
+    d.table = b.table;
+    bands.push_back(d);
+  }
+  std::vector<StarLight> stars;
+  for (const BakedStar& s : in.stars) stars.push_back(s);
+  DiffuseBakeOptions o;
+  o.degree = degree;
+  o.cells = cells;
+  o.photons = photons;
+  DiffuseBakeStats stats;
+  DiffuseField field = bake_diffuse(nebula.grid, bands, stars, o, backend, &stats);  // warm-up
+  std::vector<double> star_times, photon_times, wall_times;
+  for (int i = 0; i < repeats; ++i) {
+    star_times.push_back(bake_star_depths(nebula.grid, positions, backend).seconds);
+    const auto t0 = std::chrono::steady_clock::now();
+    field = bake_diffuse(nebula.grid, bands, stars, o, backend, &stats);
+    wall_times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    photon_times.push_back(stats.seconds);
+  }
+  out.star_bake_seconds = median_of(star_times);
+  out.photon_seconds = median_of(photon_times);
+  out.bake_wall_seconds = median_of(wall_times);
+  out.cells = field.cells.nx;
+  out.field_bytes = stats.field_bytes;
+  out.work_bytes = stats.work_bytes;
+  out.star_depth_bytes = nebula.grid.tau_v.size() * sizeof(float);
+  out.noise = stats.noise[1];
+  RenderInputs without = in, with = in;
+  with.diffuse = &field;
+  for (RenderInputs* frame : {&without, &with}) {
+    RenderStats rs;
+    render(*frame, backend, &rs);  // warm-up
+    std::vector<double> times;
+    for (int i = 0; i < repeats; ++i) {
+      render(*frame, backend, &rs);
+      times.push_back(rs.seconds);
+    }
+    (frame == &with ? out.frame_with : out.frame_without) = median_of(times);
+  }
+  return out;
 }
 
 PyramidBench bench_pyramid(Backend backend, int size, int width, int height, int levels, int repeats) {

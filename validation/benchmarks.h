@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/backend.h"
+#include "diffuse/diffuse_bake.h"
 #include "montecarlo/tabulate.h"
 #include "multires/pyramid_render.h"
 
@@ -65,6 +66,24 @@ struct RenderBenchRow {
 // on the same backend (a = g = 0.6, 10^4 photons per row).
 std::vector<RenderBenchRow> bench_render(Backend backend, int size, int width, int height, int max_stars,
                                          int repeats);
+
+// The diffuse field on the same nebula with one star (bands B, V, R, a = g =
+// 0.6): the bake after a change of the dust or the star (the star's depth bake
+// and the photon passes, medians of `repeats`), and frames without and with
+// the field (medians), with the field's memory and noise.
+struct DiffuseBench {
+  std::string backend;
+  int size = 0, width = 0, height = 0, degree = 0, cells = 0;
+  uint64_t photons = 0;        // per band
+  double star_bake_seconds = 0;  // the star's depth bake
+  double photon_seconds = 0;     // the photon passes, three bands (CUDA events on the GPU)
+  double bake_wall_seconds = 0;  // the whole diffuse bake, end to end (host clock)
+  double frame_without = 0, frame_with = 0;  // seconds per frame
+  size_t field_bytes = 0, work_bytes = 0, star_depth_bytes = 0;
+  double noise = 0;  // relative L2 noise of the V band's l = 0 part
+};
+DiffuseBench bench_diffuse(Backend backend, int size, int width, int height, int repeats, int degree, int cells,
+                           uint64_t photons);
 
 // The cost of each pyramid level on the same nebula with one star: the
 // one-time build and bake per level, and per frame the median render time of
