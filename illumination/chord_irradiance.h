@@ -10,8 +10,9 @@
 // A ray stands for its pixel: the pixels around a star hold the mean of the
 // 1 / b profile of their rays' line integrals (b the ray's distance from the
 // star), which diverges on the star's own line. Softening b^2 to b^2 + w^2 / (4
-// pi), w the pixel's width at the star's distance, gives the exact mean of a
-// square pixel centred on the star and 1 / b far from it (docs/marcher.md).
+// pi), w the pixel's width at the star's distance, gives the exact mean over a
+// round pixel of the same area centred on the star (0.55% above a square
+// one's) and 1 / b far from it (docs/marcher.md).
 #include "core/camera.h"
 #include "core/hd.h"
 #include "core/math.h"

@@ -20,8 +20,9 @@ namespace {
 // Blocks of 256 threads per SM the compiler must fit in registers (exact
 // mode). With the band loops unrolled (per-band arrays in registers, not on
 // the stack) and at most 64 registers: 4.69 ms against 5.79 ms per frame on an
-// H100 (docs/performance.md); with the diffuse field's terms, 6.72 ms
-// against 6.96 ms at 80 registers. The smooth mode keeps its 116 registers.
+// H100 (docs/performance.md, before the chord irradiance; 5.03 ms with it);
+// with the diffuse field's terms, 6.85 ms (6.72 ms against 6.96 ms at 80
+// registers before the chord irradiance). The smooth mode keeps its 116 registers.
 #ifndef NEBULA_RENDER_MIN_BLOCKS
 #define NEBULA_RENDER_MIN_BLOCKS 4
 #endif

@@ -34,8 +34,9 @@ Camera telescope(int pixels, float width) {
 // is exact); for g = 0.6 by quadrature of the table's own p (its lookup), so
 // that the test measures the marcher, not the angular binning.
 //
-// Tolerance, derived. The marcher holds the source constant over a voxel,
-// evaluated at its centre: a ray at impact parameter b sees 1/r^2 at points
+// Tolerance, derived for a marcher that holds the source constant over a
+// voxel at its centre (the chord mean of 1/r^2 the marcher now takes is exact
+// along the ray, so the bound is conservative): a ray at impact parameter b sees 1/r^2 at points
 // offset by delta from it. Averaged over an annulus of pixels (offsets spread
 // over the voxel) the first-order term cancels and 1/(b + delta)^2 leaves
 // 3 <delta^2> / b^2 relative, <delta^2> = l^2/12 per transverse axis plus the

@@ -129,7 +129,7 @@ std::optional<SceneIssue> settings_issue(const Scene& s) {
                                            " but render.multiple_scattering is \"" + to_string(s.multiple_scattering) +
                                            "\": levels belong to the pyramid (set multiple_scattering = \"pyramid\")"};
   if (s.diffuse.order < 0 || s.diffuse.order > 4)
-    return SceneIssue{"render.diffuse_order", "is " + std::to_string(s.diffuse.order) + "; must be in 0..3"};
+    return SceneIssue{"render.diffuse_order", "is " + std::to_string(s.diffuse.order) + "; must be in 0..4"};
   if (s.diffuse.cells < 1 || s.diffuse.cells > 4096)
     return SceneIssue{"render.diffuse_cells", "is " + std::to_string(s.diffuse.cells) + "; must be in 1..4096"};
   if (s.diffuse.photons < 1 || s.diffuse.photons > 0xFFFFFFFFull)

@@ -5,14 +5,23 @@ One command regenerates everything (results, plots, docs/accuracy.md):
 
     /usr/bin/python3 validation/accuracy_report.py --nebula build/bin/nebula
 
-(any python3 with numpy, matplotlib and h5py). For each scene of the standard
+(add --backend cuda on a GPU; any python3 with numpy, matplotlib and h5py). For each scene of the standard
 set (validation/scenes/*.toml) it renders a reference with `nebula truth`,
-then runs `nebula render` as each knob varies (photons per table row, the
-table's tau and mu resolution, the smooth mode's step, pyramid levels when
-`nebula render` has `--levels`) and `nebula truth` at growing spp, compares
-each image to the reference with `nebula compare --json`, and writes
-docs/accuracy.md and docs/images/accuracy_*.png. Times are what the commands
-report: the fast renderer's bake + march (tables are generated once and
+then runs `nebula render` as each knob varies and `nebula truth` at growing
+spp, compares each image to the reference with `nebula compare --json`, and
+writes docs/accuracy.md and docs/images/accuracy_*.png. The fast renderer's
+rows, by how they add the light scattered between voxels:
+  fast, fast smooth, fast table: the default, the diffuse field (its default
+    photons), as the table's photons per row, the smooth mode's step and the
+    table's tau and mu resolution vary;
+  fast diffuse: the diffuse field's photons per band (--diffuse-photons,
+    `--set render.diffuse_photons=N`) at the default tables;
+  fast none: none (`--set render.multiple_scattering=none`): single
+    scattering and the scattering inside each voxel only;
+  fast pyramid: the 2005 paper's resolution pyramid, 1 to 4 levels
+    (`--levels N`; measured when `nebula render` has `--levels`).
+Times are what the commands report: the fast renderer's star bake, diffuse-
+field bake or pyramid levels, and march (tables are generated once and
 cached; their cost is listed apart), the path tracer's tracing time.
 
 The findings (the prose that says what the tables mean) live only in
@@ -89,10 +98,21 @@ class Runner:
         return float(re.search(r"tracing ([0-9.eE+-]+) s", text).group(1))
 
     def render(self, scene, out, extra):
+        """Runs the fast renderer; returns (seconds, how it added multiple scattering between voxels). The time
+        is the star bake, the diffuse field's bake or the pyramid's coarser levels (build, bake; their render
+        is in the marching time), and the march."""
         text = self.run(["render", scene, "--backend", self.backend, "-q", "--force", "-o", out] + extra)
-        bake = re.search(r"bake: .*?, ([0-9.eE+-]+) s", text)
-        march = float(re.search(r"render: ([0-9.eE+-]+) s marching", text).group(1))
-        return march + (float(bake.group(1)) if bake else 0.0)
+        number = r"([0-9.eE+-]+)"
+        bake = re.search(r"\n\s*bake: .*?, " + number + " s", text)
+        march = float(re.search(r"render: " + number + " s marching", text).group(1))
+        diffuse = re.search(r"diffuse field \(light scattered between voxels\):.*?; " + number + r" s \(photon passes",
+                            text)
+        levels = re.findall(r"pyramid level \d+: .*?build " + number + " s, bake " + number + " s", text)
+        seconds = march + (float(bake.group(1)) if bake else 0.0) + (float(diffuse.group(1)) if diffuse else 0.0)
+        seconds += sum(float(b) + float(k) for b, k in levels)
+        with h5py.File(out, "r") as f:
+            how = f.attrs.get("multiple_scattering", b"")
+        return seconds, how.decode() if isinstance(how, bytes) else str(how)
 
     def compare(self, a, b):
         c = json.loads(self.run(["compare", a, b, "--json"]))
@@ -140,55 +160,133 @@ def study(r, name, args, rows, notes):
         out = os.path.join(d, f"truth_{spp}.h5")
         t = r.truth(scene, spp, 100 + k, out)
         rows.append(dict(scene=name, method="truth", knob="spp", value=spp, seconds=t, **summarise(r.compare(out, ref))))
+
+    def fast(method, knob, value, tag, extra):
+        """One fast render (fast_<tag>.h5) against the reference; the row records how it added the light
+        scattered between voxels, as the image's metadata says."""
+        out = os.path.join(d, f"fast_{tag}.h5")
+        t, how = r.render(scene, out, extra)
+        rows.append(dict(scene=name, method=method, knob=knob, value=value, seconds=t, multiple_scattering=how,
+                         **summarise(r.compare(out, ref))))
+
+    defaults = ["--table-photons", str(args.default_photons)]
+    # The default multiple scattering between voxels (the diffuse field) in all of: fast, fast smooth, fast table.
     for photons in args.photons:
-        out = os.path.join(d, f"fast_photons_{photons}.h5")
-        t = r.render(scene, out, ["--table-photons", str(photons)])
-        rows.append(dict(scene=name, method="fast", knob="table photons/row", value=photons, seconds=t,
-                         **summarise(r.compare(out, ref))))
+        fast("fast", "table photons/row", photons, f"photons_{photons}", ["--table-photons", str(photons)])
     for step in args.steps:
-        out = os.path.join(d, f"fast_smooth_{step}.h5")
-        t = r.render(scene, out, ["--table-photons", str(args.default_photons), "--smooth", str(step)])
-        rows.append(dict(scene=name, method="fast smooth", knob="step (voxels)", value=step, seconds=t,
-                         **summarise(r.compare(out, ref))))
+        fast("fast smooth", "step (voxels)", step, f"smooth_{step}", defaults + ["--smooth", str(step)])
     for tau_bins, mu_bins in args.resolutions:
         table = os.path.join(r.work, f"table_{tau_bins}x{mu_bins}.h5")
         sets = []
         for band in ("B", "V", "R"):
             sets += ["--set", f"dust.tables.{band}={table}"]
-        out = os.path.join(d, f"fast_table_{tau_bins}x{mu_bins}.h5")
-        t = r.render(scene, out, sets)
-        rows.append(dict(scene=name, method="fast table", knob="tau x mu bins", value=f"{tau_bins}x{mu_bins}",
-                         seconds=t, **summarise(r.compare(out, ref))))
+        fast("fast table", "tau x mu bins", f"{tau_bins}x{mu_bins}", f"table_{tau_bins}x{mu_bins}", sets)
+    # How the light scattered between voxels is added: the diffuse field's photons, none, the 2005 pyramid.
+    for photons in args.diffuse_photons:
+        fast("fast diffuse", "diffuse photons/band", photons, f"diffuse_{photons}",
+             defaults + ["--set", f"render.diffuse_photons={photons}"])
+    fast("fast none", "multiple scattering", "none", "none", defaults + ["--set", "render.multiple_scattering=none"])
     if r.has_levels:
         for levels in args.levels:
-            out = os.path.join(d, f"fast_levels_{levels}.h5")
-            t = r.render(scene, out, ["--table-photons", str(args.default_photons), "--levels", str(levels)])
-            rows.append(dict(scene=name, method="fast pyramid", knob="levels", value=levels, seconds=t,
-                             **summarise(r.compare(out, ref))))
+            fast("fast pyramid", "levels", levels, f"levels_{levels}", defaults + ["--levels", str(levels)])
 
 
-def plot(rows, images):
+# The fast renderer's rows by method: what each varies and how it adds the light scattered between voxels.
+# "fast", "fast smooth" and "fast table" run at the renderer's default, the diffuse field (method_label says so
+# when the rows' images say so; results from before the diffuse field was the default are not relabelled).
+METHODS = {
+    "truth": "truth (path tracer): spp",
+    "fast": "fast: table photons/row",
+    "fast smooth": "fast smooth: step",
+    "fast table": "fast: table τ × μ bins",
+    "fast diffuse": "fast, diffuse field: photons/band",
+    "fast none": "fast, none between voxels",
+    "fast pyramid": "fast, pyramid (2005): levels",
+}
+DEFAULT_SUFFIX = " (diffuse field, default)"
+
+
+def uses_diffuse(rows, method):
+    """Whether every row of this method added the light scattered between voxels by the diffuse field."""
+    sel = [x for x in rows if x["method"] == method]
+    return bool(sel) and all(str(x.get("multiple_scattering", "")).startswith("diffuse") for x in sel)
+
+
+def method_label(rows, method):
+    label = METHODS.get(method, method)
+    if method in ("fast", "fast smooth", "fast table") and uses_diffuse(rows, method):
+        label += DEFAULT_SUFFIX
+    return label
+
+
+def table_label(rows, method):
+    """The method column of the per-scene tables: the method, and the diffuse field where it is the default."""
+    if method in ("fast", "fast smooth", "fast table") and uses_diffuse(rows, method):
+        return method + DEFAULT_SUFFIX
+    return method
+
+
+def backend_name(backend):
+    return {"cpu": "CPU", "cuda": "GPU, CUDA"}.get(backend, f"backend {backend}")
+
+
+def short_count(n):
+    """16384 -> 16k, 1048576 -> 1M (photon counts on the plot)."""
+    n = int(n)
+    if n >= 1 << 20 and n % (1 << 20) == 0:
+        return f"{n >> 20}M"
+    if n >= 1 << 10 and n % (1 << 10) == 0:
+        return f"{n >> 10}k"
+    return f"{n:g}"
+
+
+def plot(rows, images, backend):
     os.makedirs(images, exist_ok=True)
-    markers = {"truth": "o-", "fast": "s", "fast smooth": "^", "fast table": "D", "fast pyramid": "v"}
+    # method: (matplotlib format, colour, marker size, point labels). Sweeps over one knob are joined by a line.
+    styles = {
+        "truth": ("o-", "tab:blue", 5, None),
+        "fast": ("s", "tab:orange", 5, None),
+        "fast smooth": ("^", "tab:olive", 5, None),
+        "fast table": ("D", "tab:brown", 4, None),
+        "fast diffuse": ("P-", "tab:green", 7, lambda v: short_count(v)),
+        "fast none": ("X", "tab:red", 8, None),
+        "fast pyramid": ("v-", "tab:purple", 6, lambda v: str(v)),
+    }
     # (truth orders rows are a diagnostic of the scene, not a method: left out of this plot)
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
-    fig, axes = plt.subplots(1, len(scenes), figsize=(4 * len(scenes), 3.8), sharey=True)
-    for ax, scene in zip(np.atleast_1d(axes), scenes):
-        for method, style in markers.items():
+    # One legend below the panels, as many columns as fit (about 3.5 inches each), the figure taller by its rows.
+    present = [m for m in styles if any(r["method"] == m for r in rows)]
+    ncol = max(1, min(4, len(present), int(4 * len(scenes) / 3.5)))
+    legend_inches = 0.2 * -(-len(present) // ncol) + 0.15
+    fig, axes = plt.subplots(1, len(scenes), figsize=(4 * len(scenes), 3.8 + legend_inches), sharey=True,
+                             squeeze=False)
+    axes = axes[0]
+    handles = {}
+    for ax, scene in zip(axes, scenes):
+        for method, (style, colour, size, point_label) in styles.items():
             sel = [r for r in rows if r["scene"] == scene and r["method"] == method]
             if not sel:
                 continue
+            if style.endswith("-"):
+                sel = sorted(sel, key=lambda r: r["value"])
             # The error beyond the reference's noise; the truth's own error is its noise.
             err = [max(r["rel_l2_excess"], 1e-4) if method != "truth" else r["rel_l2"] for r in sel]
-            ax.loglog([r["seconds"] for r in sel], err, style, label=method, alpha=0.8)
+            t = [r["seconds"] for r in sel]
+            (line,) = ax.loglog(t, err, style, color=colour, ms=size, lw=1, alpha=0.85)
+            handles.setdefault(method, line)
+            if point_label:
+                for x, y, r in zip(t, err, sel):
+                    ax.annotate(point_label(r["value"]), (x, y), textcoords="offset points", xytext=(4, 3),
+                                fontsize=6, color=colour)
         ref = [r for r in rows if r["scene"] == scene and r["method"] == "truth (reference)"][0]
         ax.axhline(ref["noise_rel_l2"] / np.sqrt(2), color="grey", lw=0.8, ls=":")
         ax.set_title(scene)
-        ax.set_xlabel("time (s, CPU)")
+        ax.set_xlabel(f"time (s, {backend_name(backend)})")
         ax.grid(True, which="both", alpha=0.3)
-    np.atleast_1d(axes)[0].set_ylabel("relative L2 error against the truth")
-    np.atleast_1d(axes)[0].legend(fontsize=7)
-    fig.tight_layout()
+    axes[0].set_ylabel("relative L2 error against the truth")
+    fig.legend(list(handles.values()), [method_label(rows, m) for m in handles], loc="lower center",
+               ncol=ncol, fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, legend_inches / fig.get_figheight(), 1, 1))
     fig.savefig(os.path.join(images, "accuracy_time_vs_error.png"), dpi=110)
     plt.close(fig)
 
@@ -217,6 +315,8 @@ def fmt(v):
 FINDINGS_BLOCKS = {
     "findings": ("<!-- findings: edit here; validation/accuracy_report.py keeps this block -->",
                  "<!-- end of findings -->"),
+    "diffuse findings": ("<!-- diffuse findings: edit here; validation/accuracy_report.py keeps this block -->",
+                         "<!-- end of diffuse findings -->"),
     "pyramid findings": ("<!-- pyramid findings: edit here; validation/accuracy_report.py keeps this block -->",
                          "<!-- end of pyramid findings -->"),
 }
@@ -249,76 +349,145 @@ def findings_block(name, findings):
     return f"{begin}\n\n{findings.get(name) or FINDINGS_PLACEHOLDER}\n\n{end}\n"
 
 
+def level_range(rows):
+    """The pyramid rows' levels in words: "1 to 4 levels", "2 levels", "1 level"."""
+    levels = sorted({x["value"] for x in rows if x["method"] == "fast pyramid"})
+    if not levels:
+        return "no levels measured"
+    if len(levels) == 1:
+        return f"{levels[0]} level{'s' if levels[0] != 1 else ''}"
+    return f"{levels[0]} to {levels[-1]} levels"
+
+
+def cell(x, third="worst"):
+    """A row as one table cell: bias, the L2 error beyond the truth's noise, then the worst 1% or the time."""
+    if x is None:
+        return "—"
+    last = f"{x['worst_1pct']:.2f}" if third == "worst" else f"{x['seconds']:.3g} s"
+    return f"{100 * x['bias']:+.1f}%, {x['rel_l2_excess']:.3f}, {last}"
+
+
 def write_markdown(rows, args, r, table_times, path, elapsed):
     machine = args.machine or f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores"
     findings = read_findings(path)
+    scenes = list(dict.fromkeys(x["scene"] for x in rows))
+
+    def one(scene, method, value):
+        sel = [x for x in rows if x["scene"] == scene and x["method"] == method and x["value"] == value]
+        return sel[0] if sel else None
+
+    # The default render (tables of --default-photons): its multiple scattering between voxels, as its image says.
+    defaults = [x for x in rows if x["method"] == "fast" and x["value"] == args.default_photons]
+    how = str(defaults[0].get("multiple_scattering", "")) if defaults else ""
+    diffuse_default = how.startswith("diffuse")
+    m = re.search(r"([0-9]+) photons per band", how)
+    default_field = (f"the diffuse field of {int(m.group(1))} photons per band" if m
+                     else "the diffuse field at its default photons")
+    regenerate = "/usr/bin/python3 validation/accuracy_report.py --nebula build/bin/nebula" + (
+        f" --backend {args.backend}" if args.backend != "cpu" else "")
     out = []
     out.append("<!-- Generated by validation/accuracy_report.py: the tables and plots are generated (edit the "
                "script, not them); the findings blocks between their markers are written by hand here and kept "
                "when the page is regenerated. -->")
     out.append("# Accuracy: the fast renderer and the path tracer against the ground truth\n")
-    out.append(f"Regenerate: `/usr/bin/python3 validation/accuracy_report.py --nebula build/bin/nebula` "
+    out.append(f"Regenerate: `{regenerate}` "
                f"(this run: {elapsed / 60:.1f} min on {machine}, backend {args.backend}, truth with "
                f"{args.transmittance} transmittance and "
                f"{'equiangular (MIS)' if args.equiangular else 'collision-only'} next-event estimation; "
                f"images {args.note}). The physics of the truth and how to read these numbers: "
                "[docs/truth.md](truth.md).\n")
+    out.append("The fast renderer (`nebula render`) adds the light scattered *between* voxels, by default, from "
+               "the diffuse field: a field of that light baked by photons from the stars (scene key "
+               "`render.multiple_scattering = \"diffuse\"`, photons per band `render.diffuse_photons`; "
+               "[docs/diffuse.md](diffuse.md)). The 2005 "
+               "paper's multi-resolution pyramid is kept as the alternative (`--levels N`, "
+               "[docs/pyramid.md](pyramid.md)), and `render.multiple_scattering = \"none\"` leaves that light out "
+               "(single scattering and the scattering inside each voxel, from the tables). The rows: "
+               "**fast**, **fast smooth**, **fast table**: "
+               + (f"the default, {default_field}, " if diffuse_default else "the renderer's default, ")
+               + "as the table's photons per row, the smooth mode's step and the table's τ × μ resolution vary; "
+               "**fast diffuse**: the diffuse field's photons per band, at the default tables; "
+               "**fast none**: no multiple scattering between voxels; **fast pyramid**: the pyramid with "
+               f"{level_range(rows)} instead of the diffuse field.\n")
     out.append("Columns, per image against the reference (mean over bands B, V, R; `nebula compare`): "
                "**rel L1**, **rel L2** over pixels with signal (reference above 10⁻³ of its peak); "
                "**worst 1%**: 99th percentile of the per-pixel relative error; **bias**: Σ(A−B)/ΣB; "
                "**noise**: the relative L2 the noise of both images alone gives; **excess**: the L2 error beyond "
                "that noise, √max(0, Σ(A−B)² − Σvar)/√ΣB², the fast method's own error with the reference's "
-               "noise taken out. Times: fast = bake + march (tables cached; generation times below), "
-               "truth = tracing.\n")
+               "noise taken out. Times (backend "
+               f"{args.backend}): fast = the stars' bake + the diffuse field's bake or the pyramid's coarser "
+               "levels + the march (tables cached; generation times below), truth = tracing.\n")
     out.append("![time against error](images/accuracy_time_vs_error.png)\n")
     out.append("Dotted line: the reference's own noise level (relative L2). Below it an error cannot be "
-               "resolved; `excess` is clamped at 10⁻⁴ in the plot.\n")
+               "resolved; `excess` is clamped at 10⁻⁴ in the plot. Beside the points: the diffuse field's photons "
+               "per band (green), the pyramid's levels (purple).\n")
     out.append("![truth convergence](images/accuracy_truth_convergence.png)\n")
     if not r.has_levels:
-        out.append("*Pyramid levels: not measured. This build's `nebula render` has no `--levels` option yet "
-                   "(another branch adds it); the script measures it automatically once it exists.*\n")
-    out.append("Table generation (CPU, one-off, cached by the renderer): " +
+        out.append("*Pyramid levels: not measured. This build's `nebula render` has no `--levels` option; the "
+                   "script measures them automatically when it has.*\n")
+    out.append(f"Table generation ({backend_name(args.backend)}, one-off, cached by the renderer): " +
                ", ".join(f"{k}: {v:.1f} s" for k, v in table_times.items()) + ".\n")
-    out.append("## Where the table method is biased, measured\n")
+
+    out.append("## Where the fast renderer is biased, measured\n")
     out.append("The fast renderer at its defaults (exact traversal, tables of "
-               f"{args.default_photons:g} photons per row, uniform-θ, no pyramid) against the truth; bias = "
-               "Σ(fast − truth)/Σtruth with its standard error from the truth's variance image (mean over bands), "
-               "and the L2 error beyond the truth's noise:\n")
+               f"{args.default_photons:g} photons per row, uniform-θ, "
+               + (f"{default_field} for the light scattered between voxels" if diffuse_default else
+                  f"multiple scattering between voxels: {how or 'not recorded'}")
+               + ") against the truth; bias = Σ(fast − truth)/Σtruth with its standard error from the truth's "
+               "variance image (mean over bands), and the L2 error beyond the truth's noise. The last columns: "
+               "the path tracer limited to single scattering (`--max-orders 1`) against the truth, the fast image "
+               "against that, and the same for the fast renderer without multiple scattering between voxels "
+               "(`none`: what the tables alone add to single scattering):\n")
     out.append("| scene | bias | ± | excess rel L2 | worst 1% | truth noise (rel L2) | single scattering "
-               "/ truth | fast / single scattering |")
-    out.append("|---|---|---|---|---|---|---|---|")
-    for x in rows:
-        if x["method"] == "fast" and x["value"] == args.default_photons:
-            ref = [y for y in rows if y["scene"] == x["scene"] and y["method"] == "truth (reference)"][0]
-            ss = [y for y in rows if y["scene"] == x["scene"] and y["method"] == "truth orders" and y["value"] == 1]
-            ss_text = "—"
-            if ss:
-                # Sums over the reference's signal pixels: sum(ss)/sum(truth) = 1 + bias_ss.
-                ss_text = (f"{1 + ss[0]['bias']:.3f} | {(1 + x['bias']) / (1 + ss[0]['bias']):.3f}")
-            else:
-                ss_text = "— | —"
-            out.append(f"| {x['scene']} | {100 * x['bias']:+.1f}% | {100 * x['bias_stderr']:.1f}% | "
-                       f"{x['rel_l2_excess']:.3g} | {x['worst_1pct']:.3g} | {ref['noise_rel_l2'] / np.sqrt(2):.3g} | "
-                       f"{ss_text} |")
+               "/ truth | fast / single scattering | none: bias | none / single scattering |")
+    out.append("|---|---|---|---|---|---|---|---|---|---|")
+    for x in defaults:
+        ref = [y for y in rows if y["scene"] == x["scene"] and y["method"] == "truth (reference)"][0]
+        ss = one(x["scene"], "truth orders", 1)
+        none = one(x["scene"], "fast none", "none")
+        # Sums over the reference's signal pixels: sum(ss)/sum(truth) = 1 + bias_ss.
+        ss_text = (f"{1 + ss['bias']:.3f} | {(1 + x['bias']) / (1 + ss['bias']):.3f}" if ss else "— | —")
+        none_text = f"{100 * none['bias']:+.1f}%" if none else "—"
+        none_text += f" | {(1 + none['bias']) / (1 + ss['bias']):.3f}" if none and ss else " | —"
+        out.append(f"| {x['scene']} | {100 * x['bias']:+.1f}% | {100 * x['bias_stderr']:.1f}% | "
+                   f"{x['rel_l2_excess']:.3g} | {x['worst_1pct']:.3g} | {ref['noise_rel_l2'] / np.sqrt(2):.3g} | "
+                   f"{ss_text} | {none_text} |")
     out.append("")
     out.append(findings_block("findings", findings))
+
+    photons = sorted({x["value"] for x in rows if x["method"] == "fast diffuse"})
+    if photons:
+        out.append("## The diffuse field against the truth\n")
+        out.append("The defaults above with the diffuse field baked from each number of photons per band "
+                   "(`--set render.diffuse_photons=N`), beside no multiple scattering between voxels (`none`). "
+                   "Per cell: bias, then the L2 error beyond the truth's noise, then the time (the bake included).\n")
+        out.append("| scene | none | " + " | ".join(f"{n} photons" for n in photons) + " |")
+        out.append("|---|---|" + "---|" * len(photons))
+        for scene in scenes:
+            cells = [cell(one(scene, "fast none", "none"), "time")]
+            cells += [cell(one(scene, "fast diffuse", n), "time") for n in photons]
+            out.append(f"| {scene} | " + " | ".join(cells) + " |")
+        out.append("")
+        out.append(findings_block("diffuse findings", findings))
+    elif findings["diffuse findings"]:
+        out.append("## The diffuse field against the truth\n")
+        out.append("*Not measured in this run; the findings below are from an earlier run.*\n")
+        out.append(findings_block("diffuse findings", findings))
+
     if r.has_levels:
         levels = sorted({x["value"] for x in rows if x["method"] == "fast pyramid"})
         out.append("## The pyramid against the truth\n")
-        out.append("The same defaults with 0 (the row above) to "
-                   f"{max(levels) if levels else 0} levels of the multi-resolution pyramid "
-                   "([docs/pyramid.md](pyramid.md)). "
+        out.append("The same defaults with the 2005 paper's multi-resolution pyramid ([docs/pyramid.md](pyramid.md)) "
+                   "in place of the diffuse field: 0 levels (no multiple scattering between voxels, `none`), "
+                   f"{level_range(rows)}, and last the default, the diffuse field. "
                    "Per cell: bias, then the L2 error beyond the truth's noise, then the worst 1% of pixels.\n")
-        out.append("| scene | " + " | ".join(f"{n} level{'s' if n != 1 else ''}" for n in [0] + levels) + " |")
-        out.append("|---|" + "---|" * (len(levels) + 1))
-        for scene in dict.fromkeys(x["scene"] for x in rows):
-            cells = []
-            for n in [0] + levels:
-                sel = [x for x in rows if x["scene"] == scene and (
-                    (n == 0 and x["method"] == "fast" and x["value"] == args.default_photons) or
-                    (n > 0 and x["method"] == "fast pyramid" and x["value"] == n))]
-                cells.append(f"{100 * sel[0]['bias']:+.1f}%, {sel[0]['rel_l2_excess']:.3f}, {sel[0]['worst_1pct']:.2f}"
-                             if sel else "—")
+        out.append("| scene | 0 levels (none) | " + " | ".join(f"{n} level{'s' if n != 1 else ''}" for n in levels) +
+                   (" | diffuse field (default) |" if diffuse_default else " | default |"))
+        out.append("|---|---|" + "---|" * len(levels) + "---|")
+        for scene in scenes:
+            cells = [cell(one(scene, "fast none", "none"))]
+            cells += [cell(one(scene, "fast pyramid", n)) for n in levels]
+            cells.append(cell(one(scene, "fast", args.default_photons)))
             out.append(f"| {scene} | " + " | ".join(cells) + " |")
         out.append("")
         out.append(findings_block("pyramid findings", findings))
@@ -334,9 +503,9 @@ def write_markdown(rows, args, r, table_times, path, elapsed):
         for x in rows:
             if x["scene"] != scene:
                 continue
-            out.append(f"| {x['method']} | {x['knob']} | {x['value']} | {x['seconds']:.3g} | {x['rel_l1']:.3g} | "
-                       f"{x['rel_l2']:.3g} | {x['worst_1pct']:.3g} | {x['bias']:+.3g} | {x['noise_rel_l2']:.3g} | "
-                       f"{x['rel_l2_excess']:.3g} |")
+            out.append(f"| {table_label(rows, x['method'])} | {x['knob']} | {x['value']} | {x['seconds']:.3g} | "
+                       f"{x['rel_l1']:.3g} | {x['rel_l2']:.3g} | {x['worst_1pct']:.3g} | {x['bias']:+.3g} | "
+                       f"{x['noise_rel_l2']:.3g} | {x['rel_l2_excess']:.3g} |")
         out.append("")
     with open(path + ".tmp", "w") as f:
         f.write("\n".join(out) + "\n")
@@ -362,7 +531,11 @@ def main():
     p.add_argument("--steps", type=float, nargs="*", default=[1.0, 0.5, 0.25])
     p.add_argument("--resolutions", nargs="*", default=["100x18", "100x72", "1000x18", "1000x72"])
     p.add_argument("--table-photons-res", type=int, default=10000, help="photons per row of the resolution tables")
-    p.add_argument("--levels", type=int, nargs="*", default=[1, 2, 3, 4])
+    p.add_argument("--levels", type=int, nargs="*", default=[1, 2, 3, 4],
+                   help="pyramid levels (--levels N: the 2005 pyramid instead of the diffuse field)")
+    p.add_argument("--diffuse-photons", type=int, nargs="*", default=[16384, 65536, 262144, 1048576],
+                   help="photons per band of the diffuse field (--set render.diffuse_photons=N), at the default "
+                        "tables")
     p.add_argument("--machine", default="", help="how the report names the machine")
     p.add_argument("--note", default="64x64, grids 32^3")
     p.add_argument("--docs", default=os.path.join(ROOT, "docs"))
@@ -375,7 +548,10 @@ def main():
         with open(args.from_json) as f:
             saved = json.load(f)
         r = argparse.Namespace(has_levels=saved["has_levels"])
-        plot(saved["rows"], os.path.join(args.docs, "images"))
+        # What the run measured with (results from before these were saved: the command line's).
+        for key, value in saved.get("settings", {}).items():
+            setattr(args, key, value)
+        plot(saved["rows"], os.path.join(args.docs, "images"), args.backend)
         write_markdown(saved["rows"], args, r, saved["table_times"], os.path.join(args.docs, "accuracy.md"),
                        saved["elapsed"])
         return 0
@@ -391,9 +567,10 @@ def main():
         print(f"{name} ...", flush=True)
         study(r, name, args, rows, None)
     with open(os.path.join(r.work, "results.json"), "w") as f:
-        json.dump(dict(rows=rows, table_times=table_times, has_levels=r.has_levels, elapsed=time.time() - start), f,
-                  indent=1)
-    plot(rows, os.path.join(args.docs, "images"))
+        settings = {k: getattr(args, k) for k in ("backend", "transmittance", "equiangular", "default_photons")}
+        json.dump(dict(rows=rows, table_times=table_times, has_levels=r.has_levels, settings=settings,
+                       elapsed=time.time() - start), f, indent=1)
+    plot(rows, os.path.join(args.docs, "images"), args.backend)
     write_markdown(rows, args, r, table_times, os.path.join(args.docs, "accuracy.md"), time.time() - start)
     print(f"wrote {os.path.join(args.docs, 'accuracy.md')} ({(time.time() - start) / 60:.1f} min)")
 
