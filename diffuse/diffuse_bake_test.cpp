@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/math.h"
+#include "diffuse/test_quadrature.h"
 #include "montecarlo/henyey_greenstein.h"
 
 namespace nebula {
@@ -31,28 +32,6 @@ ScatteringTable thin_table(double g) {
     for (int k = 0; k < t.n_mu(); ++k)
       t.P[t.index(i, k)] = static_cast<float>(t.tau[i] * hg_bin_mean(g, t.mu_edges[k], t.mu_edges[k + 1]));
   return t;
-}
-
-void gauss_legendre(int n, double a, double b, std::vector<double>& x, std::vector<double>& w) {
-  x.resize(n);
-  w.resize(n);
-  for (int i = 0; i < n; ++i) {
-    double z = std::cos(kPiD * (i + 0.75) / (n + 0.5)), dp = 0;
-    for (int it = 0; it < 100; ++it) {
-      double p0 = 1, p1 = z;
-      for (int k = 2; k <= n; ++k) {
-        const double p2 = ((2 * k - 1) * z * p1 - (k - 1) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      dp = n * (z * p1 - p0) / (z * z - 1);
-      const double dz = p1 / dp;
-      z -= dz;
-      if (std::fabs(dz) < 1e-15) break;
-    }
-    x[i] = 0.5 * (a + b) + 0.5 * (b - a) * z;
-    w[i] = (b - a) / ((1 - z * z) * dp * dp);
-  }
 }
 
 // Entry and exit distances of the ray s + t d (unit d) through the box [lo, hi]; false when it misses.
@@ -83,7 +62,7 @@ bool box_interval(const double s[3], const double d[3], const double lo[3], cons
 double single_scattering_fluence(const double x[3], const double star[3], const double lo[3], const double hi[3],
                                  double sigma, double albedo, double phi) {
   std::vector<double> mu, wmu, r, wr;
-  gauss_legendre(160, -1, 1, mu, wmu);
+  testing::gauss_legendre(160, -1, 1, mu, wmu);
   const int n_phi = 320;
   const double cube_lo[3] = {-1, -1, -1}, cube_hi[3] = {1, 1, 1};
   double sum = 0;
@@ -105,7 +84,7 @@ double single_scattering_fluence(const double x[3], const double star[3], const 
       }
       double line = 0;
       for (auto [p, q] : pieces) {
-        gauss_legendre(16, p, q, r, wr);
+        testing::gauss_legendre(16, p, q, r, wr);
         for (size_t k = 0; k < r.size(); ++k) {
           const double xp[3] = {star[0] + r[k] * d[0], star[1] + r[k] * d[1], star[2] + r[k] * d[2]};
           const double rho2 = (xp[0] - x[0]) * (xp[0] - x[0]) + (xp[1] - x[1]) * (xp[1] - x[1]) +

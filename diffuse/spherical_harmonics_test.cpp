@@ -7,37 +7,15 @@
 
 #include "core/math.h"
 #include "core/philox.h"
+#include "diffuse/test_quadrature.h"
 
 namespace nebula {
 namespace {
 
-// Gauss-Legendre nodes and weights on [-1, 1] (Newton on P_n).
-void gauss_legendre(int n, std::vector<double>& x, std::vector<double>& w) {
-  x.resize(n);
-  w.resize(n);
-  for (int i = 0; i < n; ++i) {
-    double z = std::cos(kPiD * (i + 0.75) / (n + 0.5)), dp = 0;
-    for (int it = 0; it < 100; ++it) {
-      double p0 = 1, p1 = z;
-      for (int k = 2; k <= n; ++k) {
-        const double p2 = ((2 * k - 1) * z * p1 - (k - 1) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      dp = n * (z * p1 - p0) / (z * z - 1);
-      const double dz = p1 / dp;
-      z -= dz;
-      if (std::fabs(dz) < 1e-15) break;
-    }
-    x[i] = z;
-    w[i] = 2 / ((1 - z * z) * dp * dp);
-  }
-}
-
 // A product rule exact for polynomials of degree <= 2 x 4 on the sphere.
 TEST(SphericalHarmonics, AreOrthonormal) {
   std::vector<double> mu, wmu;
-  gauss_legendre(12, mu, wmu);
+  testing::gauss_legendre(12, -1, 1, mu, wmu);
   const int n_phi = 24;
   double gram[kMaxShCoeffs][kMaxShCoeffs] = {};
   float y[kMaxShCoeffs];

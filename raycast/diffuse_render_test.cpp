@@ -14,18 +14,8 @@ namespace {
 using testing::cube;
 using testing::fill_sphere;
 using testing::OneStarScene;
+using testing::telescope;
 using testing::thin_table;
-
-Camera telescope(int pixels, float width) {
-  CameraSettings s;
-  s.projection = Projection::Orthographic;
-  s.position = {0, 0, -10};
-  s.look_at = {0, 0, 0};
-  s.up = {0, 1, 0};
-  s.ortho_width = width;
-  s.width = s.height = pixels;
-  return make_camera(s);
-}
 
 DiffuseField bake(const OneStarScene& s, float g, uint64_t photons, DiffuseBakeStats* stats = nullptr) {
   DiffuseBand band;
