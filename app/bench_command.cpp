@@ -252,7 +252,7 @@ void add_axial(CLI::App* bench) {
     std::vector<int> inclinations{0, 15, 30, 45, 60, 75, 90};
     int map_size = 1024, image = 2048;
     float step = 0.5f;
-    bool emission_only = false, step_aside = true;
+    bool emission_only = false, step_aside = true, diffuse = false;
   };
   auto o = std::make_shared<Options>();
   CLI::App* cmd = add_bench(bench, "axial",
@@ -271,6 +271,8 @@ void add_axial(CLI::App* bench) {
   cmd->add_option("--modes", o->modes, "comma-separated skip modes (default: all; naive always runs, first)")
       ->delimiter(',');
   cmd->add_flag("--emission-only", o->emission_only, "no star: the thesis' emission-absorption model only");
+  cmd->add_flag("--diffuse", o->diffuse,
+                "with the star, the map's diffuse field (light scattered between cells; its bake timed once per map)");
   cmd->add_flag("!--no-step-aside", o->step_aside,
                 "run the skip code even on maps without empty texels (its overhead on the full map)");
   cmd->callback([o] {
@@ -281,17 +283,20 @@ void add_axial(CLI::App* bench) {
       std::printf("\naxial maps, %s%s: map %d x %d texels, image %d x %d, step %g texel, %s; ms median of %d after a warm-up\n",
                   to_string(backend), backend == Backend::Cuda ? (" (" + gpu_description() + ")").c_str() : "",
                   o->map_size, o->map_size, image, image, o->step,
-                  o->emission_only ? "emission-absorption" : "one star on the axis (full physics)", o->repeats);
-      std::printf("| map | inclination | mode | ran | ms | speed-up vs naive | max diff / peak | samples |\n"
-                  "|---|---|---|---|---|---|---|---|\n");
+                  o->emission_only ? "emission-absorption"
+                  : o->diffuse     ? "one star on the axis (full physics) and the diffuse field"
+                                   : "one star on the axis (full physics)",
+                  o->repeats);
+      std::printf("| map | inclination | mode | ran | ms | speed-up vs naive | max diff / peak | samples | diffuse bake ms |\n"
+                  "|---|---|---|---|---|---|---|---|---|\n");
       bench_axial(backend, o->map_size, image, image, o->repeats, o->step, o->maps, o->inclinations, !o->emission_only,
                   [](const AxialBenchRow& r) {
-                    std::printf("| %s | %d | %s | %s | %.3f | %.2f | %.3g | %llu |\n", r.map.c_str(), r.inclination_deg,
-                                r.mode.c_str(), r.ran.c_str(), r.median_ms, r.speedup, r.max_difference,
-                                (unsigned long long)r.samples);
+                    std::printf("| %s | %d | %s | %s | %.3f | %.2f | %.3g | %llu | %.1f |\n", r.map.c_str(),
+                                r.inclination_deg, r.mode.c_str(), r.ran.c_str(), r.median_ms, r.speedup,
+                                r.max_difference, (unsigned long long)r.samples, r.diffuse_bake_ms);
                     std::fflush(stdout);
                   },
-                  o->step_aside, modes);
+                  o->step_aside, modes, o->diffuse);
     }
   });
 }

@@ -32,11 +32,19 @@ void print_headline(const RunReport& r) {
 // Light scattered between voxels: the diffuse field's bake, or the pyramid's levels.
 void print_multiple_scattering(const RunReport& r) {
   const DiffuseReport& d = r.diffuse;
-  if (d.done) {
+  if (d.done && d.axial) {
+    std::printf("  diffuse field (light scattered between cells): %zu band(s) x %llu photons through the map voxelized "
+                "to %dx%dx%d, harmonics to degree %d on %d x %d (x, r) cells of %g pc, ring averages; %.3g s (photon "
+                "passes %.3g s); noise of one 3D cell before the ring average, relative L2 of its l = 0 part:",
+                d.bands, (unsigned long long)d.photons_per_band, d.photon_grid.nx, d.photon_grid.ny, d.photon_grid.nz,
+                d.order, d.cells.nx, d.cells.ny, d.cells.voxel, d.wall_seconds, d.seconds);
+  } else if (d.done) {
     std::printf("  diffuse field (light scattered between voxels): %zu band(s) x %llu photons, harmonics to degree %d "
                 "on %dx%dx%d cells of %d voxel(s); %.3g s (photon passes %.3g s); noise, relative L2 of its l = 0 part:",
                 d.bands, (unsigned long long)d.photons_per_band, d.order, d.cells.nx, d.cells.ny, d.cells.nz,
                 d.voxels_per_cell, d.wall_seconds, d.seconds);
+  }
+  if (d.done) {
     for (size_t b = 0; b < d.noise.size() && b < r.bands.size(); ++b)
       if (d.noise[b] >= 0) std::printf(" %s %.2g%%", r.bands[b].name.c_str(), 100 * d.noise[b]);
     std::printf("; memory %.3g MiB kept, %.3g MiB while baking%s\n", d.field_bytes / 1048576.0,
@@ -44,7 +52,8 @@ void print_multiple_scattering(const RunReport& r) {
   } else if (r.multiple_scattering == "diffuse") {
     std::printf("  diffuse field: none (no scattering band or no star)\n");
   } else if (r.multiple_scattering == "none") {
-    std::printf("  light scattered between voxels: left out (render.multiple_scattering = \"none\")\n");
+    std::printf("  light scattered between %s: left out (render.multiple_scattering = \"none\")\n",
+                r.axial ? "cells" : "voxels");
   }
   if (r.pyramid.size() <= 1 && r.multiple_scattering == "pyramid") std::printf("  pyramid levels: none\n");
 }
@@ -73,6 +82,7 @@ void print_computed(const RunReport& r) {
     std::printf("  memory: map and skip structures %.3g MiB, with depths and tables %.3g MiB (%s)\n",
                 r.axial->map_bytes / 1048576.0, r.axial->render_bytes / 1048576.0,
                 r.backend == Backend::Cuda ? "on the GPU" : "host");
+    print_multiple_scattering(r);
     return;
   }
   std::printf("  emission: %s\n", r.emission ? "per band grid" : "none in the scene");
@@ -94,6 +104,10 @@ void print_report(const RunReport& r) {
   if (r.truth) {
     const TruthReport& t = *r.truth;
     const double s = r.render_seconds;
+    if (t.axial_grid.nx > 0)
+      std::printf("  axial map traced voxelized in its own frame: %dx%dx%d voxels of %g pc (--axial-voxels), each the "
+                  "mean of its texels\n",
+                  t.axial_grid.nx, t.axial_grid.ny, t.axial_grid.nz, t.axial_grid.voxel);
     std::printf("  paths %llu, collisions (path vertices) %llu, tentative collisions %llu, capped %llu\n",
                 (unsigned long long)t.paths, (unsigned long long)t.counters.vertices,
                 (unsigned long long)t.counters.tentative, (unsigned long long)t.counters.capped);

@@ -22,7 +22,7 @@ struct Options {
   std::string out, backend = "auto", spp;
   bool force = false, quiet = false, equiangular = false;
   std::string transmittance = "ratio";
-  int max_orders = 0, majorant_block = 4;
+  int max_orders = 0, majorant_block = 4, axial_voxels = 256;
   uint64_t seed = 1;
 };
 
@@ -35,10 +35,12 @@ void run_truth(const Options& o) {
   options.seed = o.seed;
   options.max_orders = o.max_orders;
   options.majorant_block = o.majorant_block;
+  options.axial_voxels = o.axial_voxels;
   options.exact_transmittance = o.transmittance == "exact";
   options.equiangular = o.equiangular;
   options.progress = !o.quiet;
   const OptionNames names{{"spp", "--spp"}, {"max_orders", "--max-orders"}, {"majorant_block", "--majorant-block"},
+                          {"axial_voxels", "--axial-voxels"},
                           {"backend", "--backend"}};
   const Scene scene = load_scene_options("truth", o.scene);
   const std::string var_out = variance_path(o.out);
@@ -66,6 +68,9 @@ void add_truth_command(CLI::App& app) {
   cmd->add_option("--seed", o->seed, "Philox key")->capture_default_str();
   cmd->add_option("--max-orders", o->max_orders, "scattering orders kept (0: all, the truth)")->capture_default_str();
   cmd->add_option("--majorant-block", o->majorant_block, "voxels per majorant-grid block edge")->capture_default_str();
+  cmd->add_option("--axial-voxels", o->axial_voxels,
+                  "an axial map is traced voxelized in its own frame: voxels along its longer side")
+      ->capture_default_str();
   cmd->add_option("--transmittance", o->transmittance,
                   "to the stars: ratio (residual ratio tracking) or exact (the voxel sum: no noise)")
       ->capture_default_str();

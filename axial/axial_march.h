@@ -57,7 +57,45 @@ struct AxialMarchScene {
   AxialSkip skip = AxialSkip::Distance;
   float min_transmittance = 1e-4f;
   RayFootprint footprint;  // the camera's pixel width along a ray (starlight near a star)
+  bool has_diffuse = false;  // light scattered between cells (axial/axial_diffuse.h), per band where baked
+  DiffuseView diffuse;       // cells {along the axis, from it, 1}, harmonics in the meridian frames
 };
+
+// The diffuse field's light a texel of V-band depth tau_v at sample point q
+// (relative to the map's origin; x along the axis, r from it) sends towards
+// the eye per band, per unit of chord / l, added to `source`; its forward
+// peak per band into `peak`. The field is kept in each meridian's frame (x'
+// away from the axis, y' around it, z' along it), so the way to the eye is
+// turned into that frame first. Evaluated per sample: unlike the grid's
+// voxels, a texel is a ring and meets the eye from every side.
+NEBULA_HD void add_axial_diffuse_light(const AxialMarchScene& s, Vec3 q, float x, float r, float tau_v, Vec3 to_eye,
+                                       float* source, float* peak) {
+  const AxialView& m = s.map;
+  const DiffuseView& f = s.diffuse;
+  Vec3 e_r, e_phi;
+  if (r > 0.0f) {
+    e_r = (1.0f / r) * (q - x * m.axis);
+    e_phi = cross(m.axis, e_r);
+  } else {
+    orthonormal_frame(m.axis, e_r, e_phi);  // on the axis the field is symmetric about it: any frame
+  }
+  const Vec3 local{dot(to_eye, e_r), dot(to_eye, e_phi), dot(to_eye, m.axis)};
+  const float inv_edge = 1.0f / f.cells.voxel;
+  int cx = static_cast<int>(x * inv_edge), cr = static_cast<int>(r * inv_edge);
+  cx = cx < 0 ? 0 : (cx >= f.cells.nx ? f.cells.nx - 1 : cx);
+  cr = cr >= f.cells.ny ? f.cells.ny - 1 : cr;
+  float D[kMaxBands][kMaxDiffuseDegree + 1];
+  f.project<kMaxDiffuseDegree>(f.cells.index(cx, cr, 0), local, D, f.degree);
+  NEBULA_UNROLL
+  for (int b = 0; b < kMaxBands; ++b)
+    if (b < s.n_bands && f.has[b]) {
+      float p = 0.0f;
+      const float light =
+          f.scattered<kMaxDiffuseDegree>(b, s.albedo[b] * tau_v * s.extinction_ratio[b], D[b], &p, f.degree);
+      source[b] += fmaxf(0.0f, light);  // a truncated series may dip below 0; the light cannot
+      peak[b] = p;
+    }
+}
 
 // The ray in the map's frame: x(t) = x0 + t dx along the axis, and the part
 // perpendicular to the axis w(t) = w0 + t wd, r(t) = |w(t)|.
@@ -187,11 +225,14 @@ NEBULA_HD float distance_reach(int d, float texel, float inv_speed, float eps) {
 }  // namespace axial_detail
 
 // One ray through the axial map: radiance and transmittance per band. The
-// skip mode (s.skip is not read) and whether there are stars are fixed at
-// compile time, so each kernel holds only what its scene needs (a scene
-// without stars carries no table lookups in its registers). `visited` (may
-// be null) counts the samples the loop stepped through.
-template <AxialSkip kMode, bool kStars>
+// skip mode (s.skip is not read), whether there are stars and whether there
+// is a diffuse field (s.has_diffuse is not read) are fixed at compile time, so
+// each kernel holds only what its scene needs (a scene without stars carries
+// no table lookups in its registers). With the field, its light adds to the
+// texel's source and its forward peak to the texel's transmittance, as in the
+// grid marcher (ray_march.h). `visited` (may be null) counts the samples the
+// loop stepped through.
+template <AxialSkip kMode, bool kStars, bool kDiffuse = false>
 NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 dir, int* visited = nullptr) {
   RayResult out{};
   for (int b = 0; b < kMaxBands; ++b) out.transmittance[b] = 1.0f;
@@ -257,6 +298,7 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
     if (skip == int(AxialSkip::Naive) || !empty) {
       float tau_v = 0.0f;
       float source[kMaxBands] = {};
+      float peak[kMaxBands] = {};  // the diffuse response's forward peak (kDiffuse)
       bool dark = true;
       if (!empty) {
         const size_t cell = m.index(ix, ir);
@@ -275,6 +317,8 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
                                             s.stars[k_star].position, s.footprint),
                            tau_v, to_eye, source, &out.table_clamps);
         }
+        if constexpr (kDiffuse)
+          if (tau_v > 0.0f) add_axial_diffuse_light(s, q, x, r, tau_v, to_eye, source, peak);
       }
       empty = empty || dark;
       // T_in rule (DESIGN.md section 3), the texel in the voxel's part.
@@ -291,7 +335,10 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
       for (int b = 0; b < kMaxBands; ++b) {
         if (b >= s.n_bands) break;
         out.radiance[b] += t_entry[b] * source[b] * fraction;
-        out.transmittance[b] *= expf(-tau_v * s.extinction_ratio[b] * fraction);
+        if constexpr (kDiffuse)
+          out.transmittance[b] *= fminf(1.0f, expf(-tau_v * s.extinction_ratio[b] * fraction) + peak[b] * fraction);
+        else
+          out.transmittance[b] *= expf(-tau_v * s.extinction_ratio[b] * fraction);
         visible = visible || out.transmittance[b] >= s.min_transmittance;
       }
       if (!visible) break;
@@ -353,13 +400,15 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
   return out;
 }
 
-// Calls f(mode, stars) with std::integral_constant / std::bool_constant for
-// the run-time mode and whether the scene has stars: the one place that
-// turns them into template arguments (the CPU loop, the CUDA launch).
+// Calls f(mode, stars, diffuse) with std::integral_constant / std::bool_constant
+// for the run-time mode, whether the scene has stars and whether it has a
+// diffuse field (only with stars): the one place that turns them into
+// template arguments (the CPU loop, the CUDA launch).
 template <class F>
-decltype(auto) dispatch_axial(AxialSkip mode, bool stars, F&& f) {
+decltype(auto) dispatch_axial(AxialSkip mode, bool stars, bool diffuse, F&& f) {
   auto with_stars = [&](auto m) -> decltype(auto) {
-    return stars ? f(m, std::true_type{}) : f(m, std::false_type{});
+    if (!stars) return f(m, std::false_type{}, std::false_type{});
+    return diffuse ? f(m, std::true_type{}, std::true_type{}) : f(m, std::true_type{}, std::false_type{});
   };
   switch (mode) {
     case AxialSkip::Naive: return with_stars(std::integral_constant<AxialSkip, AxialSkip::Naive>{});

@@ -76,6 +76,13 @@ void validate(const AxialRenderInputs& in) {
       throw Error("axial render: star " + std::to_string(k) + " lies " + to_text(off) +
                   " from the axis; stars must be on the axis (then their light is axisymmetric)");
   }
+  if (in.diffuse) {
+    const DiffuseField& f = *in.diffuse;
+    if (f.cells.nz != 1 || f.cells.nx < 1 || f.cells.ny < 1 || !(f.cells.voxel > 0) || f.coeffs.size() != in.bands.size())
+      throw Error("axial render: the diffuse field is not an axial one for these bands (axial/axial_diffuse.h)");
+    if (f.packed.size() != f.cells.count() * size_t(f.n_coeffs()) * 4)
+      throw Error("axial render: the diffuse field is not packed");
+  }
 }
 
 Image render_axial_cpu(const AxialRenderInputs& in, AxialRenderStats* stats) {
@@ -84,7 +91,7 @@ Image render_axial_cpu(const AxialRenderInputs& in, AxialRenderStats* stats) {
   Image image(in.camera.width, in.camera.height, band_names(in.bands));
   std::atomic<uint64_t> clamps{0}, reads{0};
   const auto start = std::chrono::steady_clock::now();
-  dispatch_axial(scene.skip, scene.n_stars > 0, [&](auto mode, auto has_stars) {
+  dispatch_axial(scene.skip, scene.n_stars > 0, scene.has_diffuse, [&](auto mode, auto has_stars, auto diffuse) {
     tbb::parallel_for(tbb::blocked_range<int>(0, in.camera.height), [&](const auto& rows) {
       uint64_t local = 0, local_reads = 0;
       for (int y = rows.begin(); y != rows.end(); ++y)
@@ -93,7 +100,8 @@ Image render_axial_cpu(const AxialRenderInputs& in, AxialRenderStats* stats) {
           if (!in.camera.ray(x, y, origin, dir)) continue;
           int visited = 0;
           const RayResult r =
-              march_axial_ray<decltype(mode)::value, decltype(has_stars)::value>(scene, origin, dir, &visited);
+              march_axial_ray<decltype(mode)::value, decltype(has_stars)::value, decltype(diffuse)::value>(
+                  scene, origin, dir, &visited);
           local_reads += uint64_t(visited);
           store_radiance(r, scene.n_bands, in.exposure, image.pixels.data(), image.width, image.height, x, y);
           local += uint64_t(r.table_clamps);

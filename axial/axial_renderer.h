@@ -12,6 +12,7 @@
 #include "core/bands.h"
 #include "core/camera.h"
 #include "core/image.h"
+#include "diffuse/diffuse_field.h"
 #include "tables/scattering_table.h"
 
 namespace nebula {
@@ -29,6 +30,9 @@ struct AxialRenderInputs {
   const AxialMap* map = nullptr;  // emission, if any, per band in the bands' order
   std::vector<AxialRenderBand> bands;
   std::vector<BakedStar> stars;  // on the map's axis; depth_v per texel (axial_bake.h)
+  // Light scattered between cells (axial_diffuse.h), baked for this map,
+  // these bands and stars; null: single scattering (and the table's own).
+  const DiffuseField* diffuse = nullptr;
   Camera camera;
   float exposure = 1.0f;
   float min_transmittance = 1e-4f;

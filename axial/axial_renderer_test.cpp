@@ -89,14 +89,6 @@ TEST(AxialRender, UniformCylinderMatchesTheClosedForm) {
   }
 }
 
-double relative_l1(const Image& a, const Image& ref) {
-  double d = 0, s = 0;
-  for (size_t i = 0; i < a.pixels.size(); ++i) {
-    d += std::fabs(double(a.pixels[i]) - ref.pixels[i]);
-    s += std::fabs(double(ref.pixels[i]));
-  }
-  return d / s;
-}
 
 // The same nebula as a 3D grid (voxel = half a texel, each voxel the texel
 // at its centre, tau_v and j rescaled per voxel edge), rendered by the exact
@@ -127,7 +119,7 @@ TEST(AxialRender, VoxelizedGridRendersTheSameNebula) {
     in.stars.push_back(BakedStar{{s.inputs.stars[0].position, s.inputs.stars[0].power}, &depth});
     in.camera = s.inputs.camera;
     const Image voxels = render_cpu(in, nullptr);
-    const double err = relative_l1(axial, voxels);
+    const double err = testing::relative_l1(axial, voxels);
     double flux_axial = 0, flux_voxels = 0;
     for (size_t i = 0; i < axial.pixels.size(); ++i) {
       flux_axial += axial.pixels[i];

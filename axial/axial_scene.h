@@ -37,6 +37,10 @@ AxialMarchScene assemble_axial_scene(const AxialRenderInputs& in, Place& place) 
   }
   scene.stars = place_star_views(in.stars, scene.n_bands, place);
   scene.n_stars = static_cast<int>(in.stars.size());
+  if (in.diffuse && scene.n_stars > 0) {
+    scene.has_diffuse = true;
+    scene.diffuse = place_diffuse(*in.diffuse, place);
+  }
   return scene;
 }
 

@@ -62,4 +62,14 @@ struct AxialScene {
   }
 };
 
+// sum |a - ref| / sum |ref| over every pixel of every band.
+inline double relative_l1(const Image& a, const Image& ref) {
+  double d = 0, s = 0;
+  for (size_t i = 0; i < a.pixels.size(); ++i) {
+    d += std::fabs(double(a.pixels[i]) - ref.pixels[i]);
+    s += std::fabs(double(ref.pixels[i]));
+  }
+  return d / s;
+}
+
 }  // namespace nebula::testing

@@ -81,20 +81,24 @@ struct DiffuseView {
   NEBULA_HD size_t cell_of(int x, int y, int z) const { return cells.index(x >> shift, y >> shift, z >> shift); }
 
   // D[b][l] = sum over m of Y_lm(e) L_lm of band b at `cell`, with e the
-  // direction to the eye; kDeg is the field's degree, fixed at compile time
-  // so that D stays in registers.
+  // direction to the eye, for l <= deg (0 above). kDeg bounds deg at compile
+  // time so that D stays in registers: the grid marcher's prepass passes its
+  // field's degree as kDeg; the axial marcher, which projects per sample,
+  // passes kMaxDiffuseDegree and the field's degree as deg.
   template <int kDeg>
-  NEBULA_HD void project(size_t cell, Vec3 to_eye, float (&D)[kMaxBands][kDeg + 1]) const {
-    constexpr int n = (kDeg + 1) * (kDeg + 1);
-    float y[n];
-    sh_basis(kDeg, to_eye, y);
+  NEBULA_HD void project(size_t cell, Vec3 to_eye, float (&D)[kMaxBands][kDeg + 1], int deg = kDeg) const {
+    constexpr int n_max = (kDeg + 1) * (kDeg + 1);
+    const int n = (deg + 1) * (deg + 1);
+    float y[n_max];
+    sh_basis(deg, to_eye, y);
     NEBULA_UNROLL
     for (int b = 0; b < kMaxBands; ++b)
       NEBULA_UNROLL
       for (int l = 0; l <= kDeg; ++l) D[b][l] = 0.0f;
     const float* c = packed + cell * size_t(n) * 4;
     NEBULA_UNROLL
-    for (int k = 0; k < n; ++k) {
+    for (int k = 0; k < n_max; ++k) {
+      if (k >= n) break;
       const Quad q = load_quad(c + 4 * k);
       const int l = sh_degree_of(k);
       NEBULA_UNROLL
@@ -103,28 +107,29 @@ struct DiffuseView {
   }
 
   // sum_l p*_l(tau_sct) D_l for band b, and the forward peak p_{N+1}(tau_sct)
-  // in *peak: the response, linear between table rows (clamped to the last
+  // in *peak (deg and kDeg as for project): the response, linear between table rows (clamped to the last
   // one, as the table lookup is). Both rows' sums are taken, then
   // interpolated: fewer operations than interpolating each moment.
   template <int kDeg>
-  NEBULA_HD float scattered(int b, float tau_sct, const float (&D)[kDeg + 1], float* peak) const {
+  NEBULA_HD float scattered(int b, float tau_sct, const float (&D)[kDeg + 1], float* peak, int deg = kDeg) const {
     const float u = fminf(fmaxf(tau_sct * rows_per_tau[b], 0.0f), float(rows[b] - 1));
     int i = static_cast<int>(u);
     i = i > rows[b] - 2 ? rows[b] - 2 : i;
     const float f = u - float(i);
-    constexpr int stride = diffuse_response_stride(kDeg);
+    const int stride = diffuse_response_stride(deg);
     const float* r0 = response[b] + size_t(i) * stride;
     float s[2] = {0.0f, 0.0f}, p[2] = {0.0f, 0.0f};
     NEBULA_UNROLL
     for (int row = 0; row < 2; ++row)
       NEBULA_UNROLL
-      for (int q = 0; q < stride / 4; ++q) {
+      for (int q = 0; q < diffuse_response_stride(kDeg) / 4; ++q) {
+        if (4 * q >= stride) break;
         const Quad r = load_quad(r0 + row * stride + 4 * q);
         NEBULA_UNROLL
         for (int j = 0; j < 4; ++j) {
           const int l = 4 * q + j;
-          if (l <= kDeg) s[row] += r.v[j] * D[l < kDeg ? l : kDeg];
-          if (l == kDeg + 1) p[row] = r.v[j];
+          if (l <= deg) s[row] += r.v[j] * D[l <= kDeg ? l : kDeg];
+          if (l == deg + 1) p[row] = r.v[j];
         }
       }
     *peak = p[0] + f * (p[1] - p[0]);

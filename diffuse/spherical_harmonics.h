@@ -57,6 +57,28 @@ NEBULA_HD void sh_basis(int degree, Vec3 d, float* y) {
   y[24] = 0.6258357354491761f * (x2 * (x2 - 3.0f * y2) - y2 * (3.0f * x2 - y2));
 }
 
+// The harmonics of a function seen from a frame turned by angle phi about z
+// (cos_phi, sin_phi): out_k = integral f(d) Y_k(d') dd, d' the direction d in
+// the turned frame, whose azimuth is d's minus phi. Order m > 0 goes with
+// cos(m psi), m < 0 with sin(|m| psi) (sh_basis), so each pair (m, -m) turns by
+// m phi. The axial field (axial/) stores its harmonics in each meridian's
+// frame. `in` and `out` must not overlap.
+NEBULA_HD void sh_rotate_z(int degree, float cos_phi, float sin_phi, const float* in, float* out) {
+  out[0] = in[0];
+  float cm = 1.0f, sm = 0.0f;  // cos(m phi), sin(m phi), by the angle-sum recursion
+  for (int m = 1; m <= degree; ++m) {
+    const float c = cm * cos_phi - sm * sin_phi;
+    sm = sm * cos_phi + cm * sin_phi;
+    cm = c;
+    for (int l = m; l <= degree; ++l) {
+      const int centre = l * l + l;
+      out[centre + m] = cm * in[centre + m] + sm * in[centre - m];
+      out[centre - m] = cm * in[centre - m] - sm * in[centre + m];
+    }
+  }
+  for (int l = 1; l <= degree; ++l) out[l * l + l] = in[l * l + l];
+}
+
 // The degree l of harmonic k.
 NEBULA_HD int sh_degree_of(int k) { return k < 1 ? 0 : (k < 4 ? 1 : (k < 9 ? 2 : (k < 16 ? 3 : 4))); }
 

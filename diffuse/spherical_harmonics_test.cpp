@@ -63,5 +63,25 @@ TEST(SphericalHarmonics, LegendreMatchesItsClosedForms) {
   for (int k = 0; k < 25; ++k) EXPECT_EQ(sh_degree_of(k), int(std::sqrt(double(k))));
 }
 
+// Turning the frame by phi about z: the harmonics of a direction seen from
+// the turned frame are the turned harmonics of the direction, for every
+// degree and angle (the relation the axial field's meridian frames rely on).
+TEST(SphericalHarmonics, TurnAboutTheZAxis) {
+  float y[kMaxShCoeffs], turned[kMaxShCoeffs], local[kMaxShCoeffs];
+  for (uint32_t t = 0; t < 100; ++t) {
+    const Uniform4 u = philox_uniform4(11, 0, t, 0, 0);
+    const float z = 1 - 2 * u.u0, s = std::sqrt(1 - z * z), psi = 2 * kPi * u.u1, phi = 2 * kPi * u.u2;
+    const Vec3 d{s * std::cos(psi), s * std::sin(psi), z};
+    // d in the frame whose x axis is (cos phi, sin phi, 0).
+    const Vec3 d_local{s * std::cos(psi - phi), s * std::sin(psi - phi), z};
+    for (int degree = 0; degree <= kMaxShDegree; ++degree) {
+      sh_basis(degree, d, y);
+      sh_basis(degree, d_local, local);
+      sh_rotate_z(degree, std::cos(phi), std::sin(phi), y, turned);
+      for (int k = 0; k < sh_count(degree); ++k) EXPECT_NEAR(turned[k], local[k], 2e-5f) << "degree " << degree << " k " << k;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace nebula

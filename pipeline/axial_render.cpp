@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "axial/axial_bake.h"
+#include "axial/axial_diffuse.h"
 #include "axial/axial_renderer.h"
 #include "core/error.h"
 #include "core/progress.h"
@@ -20,6 +21,9 @@ namespace {
 
 RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
   if (o.smooth_step != 0) throw ParameterError("smooth_step", "not for axial maps (their step is axial.step_texels)");
+  if (scene.multiple_scattering == MultipleScattering::Pyramid)
+    throw ParameterError(scene.path + ": render.multiple_scattering",
+                         "\"pyramid\" is for 3D grids; an axial map takes \"diffuse\" (the default) or \"none\"");
   validate_scene(scene);
   const AxialSpec& spec = *scene.axial;
   const AxialSkip skip = parse_axial_skip(spec.skip, scene.path + ": axial.skip");
@@ -68,8 +72,27 @@ RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
     report.bake = {true, star_x.size(), map.count(), seconds_since(t0)};
   }
 
+  // Light scattered between cells: the diffuse field, baked by photons from
+  // the stars through the map voxelized in its own frame, kept on the map.
+  const bool diffuse = scene.multiple_scattering == MultipleScattering::Diffuse && any && !star_x.empty();
+  report.multiple_scattering = to_string(scene.multiple_scattering);
+  DiffuseField field;
+  if (diffuse) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::vector<DiffuseBand> bands = diffuse_bands(sb, tables);
+    const DiffuseBakeOptions options = diffuse_options(scene);
+    AxialDiffuseStats stats;
+    std::unique_ptr<Progress> bar = diffuse_progress(bands, options, o);
+    field = bake_axial_diffuse(map, bands, sb.stars, options, o.backend, &stats, bar.get());
+    if (bar) bar->finish();
+    report.diffuse = diffuse_report(bands, options, field, 0, stats.bake, seconds_since(t0));
+    report.diffuse.axial = true;
+    report.diffuse.photon_grid = stats.grid;
+  }
+
   AxialRenderInputs in;
   in.map = &map;
+  if (diffuse) in.diffuse = &field;
   for (size_t b = 0; b < n_bands; ++b) {
     Band band = sb.bands[b];
     if (!scatters[b]) band.albedo = 0.0f;
@@ -96,6 +119,7 @@ RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
   report.render_seconds = stats.seconds;
   report.table_clamps = stats.table_clamps;
   out.metadata = scene_metadata(scene, sb, scene.camera, report.mode);
+  out.metadata.entries.push_back({"multiple_scattering", multiple_scattering_text(report)});
   return out;
 }
 

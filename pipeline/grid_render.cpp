@@ -17,16 +17,6 @@ using namespace pipeline_detail;
 
 namespace {
 
-// What the image's light between voxels came from, for its metadata.
-std::string multiple_scattering_text(const RunReport& r) {
-  if (r.diffuse.done)
-    return "diffuse order " + std::to_string(r.diffuse.order) + ", " + std::to_string(r.diffuse.cells.nx) + "x" +
-           std::to_string(r.diffuse.cells.ny) + "x" + std::to_string(r.diffuse.cells.nz) + " cells, " +
-           std::to_string(r.diffuse.photons_per_band) + " photons per band";
-  if (r.multiple_scattering == "pyramid") return "pyramid " + std::to_string(r.pyramid.size() - 1) + " levels";
-  return r.multiple_scattering == "diffuse" ? "none (nothing scatters starlight)" : "none";
-}
-
 std::string mode_of(const RenderOptions& o) {
   return o.smooth_step > 0 ? "smooth step " + to_text(o.smooth_step) + " voxel" : "exact";
 }
@@ -80,43 +70,13 @@ PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o) {
   p.report.multiple_scattering = to_string(scene.multiple_scattering);
   if (diffuse) {
     const auto t0 = std::chrono::steady_clock::now();
-    std::vector<DiffuseBand> bands;
-    for (size_t b = 0; b < n_bands; ++b) {
-      DiffuseBand band;
-      static_cast<Band&>(band) = p.bands.bands[b];
-      band.table = p.tables.per_band[b].get();
-      if (!band.table) band.albedo = 0.0f;
-      bands.push_back(band);
-    }
-    DiffuseBakeOptions options;
-    options.degree = scene.diffuse.order;
-    options.cells = scene.diffuse.cells;
-    options.photons = scene.diffuse.photons;
-    options.seed = scene.diffuse.seed;
+    const std::vector<DiffuseBand> bands = diffuse_bands(p.bands, p.tables);
+    const DiffuseBakeOptions options = diffuse_options(scene);
     DiffuseBakeStats stats;
-    std::unique_ptr<Progress> bar;
-    if (o.progress && o.backend == Backend::Cpu) {
-      size_t baked = 0;
-      for (const DiffuseBand& b : bands) baked += b.albedo > 0;
-      bar = std::make_unique<Progress>("diffuse", options.photons * baked);
-    }
+    std::unique_ptr<Progress> bar = diffuse_progress(bands, options, o);
     p.diffuse = bake_diffuse(scene.density, bands, p.bands.stars, options, o.backend, &stats, bar.get());
     if (bar) bar->finish();
-    DiffuseReport& r = p.report.diffuse;
-    r.done = true;
-    r.order = options.degree;
-    r.cells = p.diffuse.cells;
-    r.voxels_per_cell = 1 << p.diffuse.shift;
-    r.photons_per_band = options.photons;
-    for (const DiffuseBand& b : bands) r.bands += b.albedo > 0;
-    r.seconds = stats.seconds;
-    r.wall_seconds = seconds_since(t0);
-    r.noise = stats.noise;
-    r.collisions = stats.counters.collisions;
-    r.crossings = stats.counters.crossings;
-    r.capped = stats.counters.capped;
-    r.field_bytes = stats.field_bytes;
-    r.work_bytes = stats.work_bytes;
+    p.report.diffuse = diffuse_report(bands, options, p.diffuse, 1 << p.diffuse.shift, stats, seconds_since(t0));
   }
 
   RenderInputs& in = p.inputs;

@@ -68,6 +68,7 @@ struct TruthOptions {
   int majorant_block = 4;            // "majorant_block": voxels per block edge
   bool exact_transmittance = false;  // next-event transmittance by the exact voxel sum
   bool equiangular = false;          // equiangular next-event samples too (MIS)
+  int axial_voxels = 256;            // "axial_voxels": an axial map is traced voxelized, this many along its longer side
   bool progress = false;
 };
 

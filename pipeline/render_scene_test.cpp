@@ -167,6 +167,7 @@ TEST_F(RenderScene, AxialMapsAndTheTruthRunThroughTheSamePipeline) {
       "axial.toml",
       "bands = [\"B\", \"V\"]\n[axial]\nsynthetic = \"shells\"\nnx = 32\nnr = 16\nemission_scale = 1.0\n"
       "[[stars]]\nposition = [0.0, 0.0, 1.0]\nluminosity_lsun = 10\nclass = \"B0V\"\n"
+      "[render]\ndiffuse_photons = 20000\n"
       "[camera]\nposition = [4.0, 0.0, 1.0]\nlook_at = [0.0, 0.0, 1.0]\nwidth = 12\nheight = 12\n"));
   const RenderOutput a = render_scene(axial, options());
   ASSERT_TRUE(a.report.axial.has_value());
@@ -186,7 +187,47 @@ TEST_F(RenderScene, AxialMapsAndTheTruthRunThroughTheSamePipeline) {
   ASSERT_TRUE(truth.report.truth.has_value());
   EXPECT_EQ(truth.report.truth->paths, 20u * 16u * 4u * 3u);
   EXPECT_EQ(truth.variance_metadata.units, "(L_sun pc^-2 sr^-1 x exposure)^2, variance of the pixel mean");
-  EXPECT_THROW(truth_scene(axial, t), Error);
+  t.axial_voxels = 64;
+  const TruthRenderOutput axial_truth = truth_scene(axial, t);
+  ASSERT_TRUE(axial_truth.report.truth.has_value());
+  EXPECT_EQ(axial_truth.report.truth->axial_grid.nz, 64);  // along the map's longer side, its length (32 x 16 texels)
+  EXPECT_EQ(axial_truth.report.truth->axial_grid.nx, 64);
+  EXPECT_EQ(axial_truth.image.width, 12);
+}
+
+// The truth traces an axial map voxelized in the map's own frame, the camera
+// moved with it: on a tilted axis, seen from the side, with emission only
+// and no scattering (which the axial marcher integrates without
+// approximation but its step), the two images agree up to the truth's noise,
+// the voxels' staircase and the marcher's step around the small emitting
+// core. Measured: flux 0.6% apart at a step of 0.1 texel and 256 voxels
+// (3.9% at the default step of 0.5); bounds 2% and, per pixel, 3% of the
+// peak. A frame turned or mirrored the wrong way would put the cloud elsewhere.
+TEST_F(RenderScene, TheTruthTracesAnAxialMapInItsOwnFrame) {
+  const Scene axial = load_scene(write_text(
+      "axial_tilted.toml",
+      "bands = [\"V\"]\n[axial]\nsynthetic = \"lopsided\"\nnx = 32\nnr = 16\nlength_pc = 2.0\n"
+      "origin = [0.1, -0.3, 0.2]\naxis = [1.0, 2.0, 2.0]\nemission_scale = 1.0\ntau_scale = 0.05\nstep_texels = 0.1\n[dust]\nalbedo = 0.0\n"
+      "[camera]\nposition = [4.0, -3.0, 1.0]\nlook_at = [0.8, 1.0, 1.5]\nfov_deg = 45\nwidth = 24\nheight = 24\n"));
+  const RenderOutput fast = render_scene(axial, options());
+  TruthOptions t;
+  t.spp = 16;
+  const TruthRenderOutput truth = truth_scene(axial, t);
+  float peak = 0;
+  for (float v : fast.image.pixels) peak = std::max(peak, v);
+  ASSERT_GT(peak, 0.0f);
+  double worst = 0, sum_f = 0, sum_t = 0, var = 0;
+  for (size_t i = 0; i < fast.image.pixels.size(); ++i) {
+    const double d = std::fabs(fast.image.pixels[i] - truth.image.pixels[i]) - 4 * std::sqrt(truth.variance.pixels[i]);
+    worst = std::max(worst, d / peak);
+    sum_f += fast.image.pixels[i];
+    sum_t += truth.image.pixels[i];
+    var += truth.variance.pixels[i];
+  }
+  std::printf("axial emission: worst pixel beyond 4 sigma %.4f of the peak, flux ratio %.4f +- %.4f\n", worst,
+              sum_t / sum_f, std::sqrt(var) / sum_f);
+  EXPECT_LT(worst, 0.03);
+  EXPECT_NEAR(sum_t / sum_f, 1.0, 0.02 + 4 * std::sqrt(var) / sum_f);
 }
 
 }  // namespace

@@ -45,8 +45,10 @@ struct BakeReport {
 struct DiffuseReport {
   bool done = false;
   int order = 0;
-  GridShape cells;             // the field's cells
+  GridShape cells;             // the field's cells ({along the axis, from it, 1} for an axial map)
   int voxels_per_cell = 1;     // along each axis
+  bool axial = false;          // an axial map's field: photons on `photon_grid`, the map voxelized
+  GridShape photon_grid;
   uint64_t photons_per_band = 0;
   size_t bands = 0;            // bands baked (those that scatter)
   double seconds = 0;          // the photon passes (CUDA events on the GPU)
@@ -77,6 +79,7 @@ struct TruthReport {
   bool equiangular = false;
   uint64_t paths = 0;
   PathCounters counters;
+  GridShape axial_grid;  // an axial map's voxelization in its own frame (nx = 0: a 3D grid scene)
 };
 
 struct RunReport {

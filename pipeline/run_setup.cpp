@@ -1,6 +1,8 @@
 #include "pipeline/run_setup.h"
 
 #include "core/error.h"
+#include "core/progress.h"
+#include "pipeline/render_scene.h"
 #include "raycast/point_stars.h"
 
 namespace nebula::pipeline_detail {
@@ -52,6 +54,66 @@ void draw_scene_stars(const Scene& scene, const SceneBands& bands, const Camera&
   for (const Band& b : bands.bands) ratios.push_back(b.extinction_ratio);
   draw_point_stars(scene.density, bands.stars, ratios, camera, static_cast<float>(exposure), scene.star_psf_pixels,
                    image);
+}
+
+// What the image's light between voxels came from, for its metadata.
+std::string multiple_scattering_text(const RunReport& r) {
+  if (r.diffuse.done)
+    return std::string(r.diffuse.axial ? "axial " : "") + "diffuse order " + std::to_string(r.diffuse.order) + ", " + std::to_string(r.diffuse.cells.nx) + "x" +
+           std::to_string(r.diffuse.cells.ny) + "x" + std::to_string(r.diffuse.cells.nz) + " cells, " +
+           std::to_string(r.diffuse.photons_per_band) + " photons per band";
+  if (r.multiple_scattering == "pyramid") return "pyramid " + std::to_string(r.pyramid.size() - 1) + " levels";
+  return r.multiple_scattering == "diffuse" ? "none (nothing scatters starlight)" : "none";
+}
+
+std::vector<DiffuseBand> diffuse_bands(const SceneBands& bands, const BandTables& tables) {
+  std::vector<DiffuseBand> out;
+  for (size_t b = 0; b < bands.bands.size(); ++b) {
+    DiffuseBand band;
+    static_cast<Band&>(band) = bands.bands[b];
+    band.table = tables.per_band[b].get();
+    if (!band.table) band.albedo = 0.0f;
+    out.push_back(band);
+  }
+  return out;
+}
+
+DiffuseBakeOptions diffuse_options(const Scene& scene) {
+  DiffuseBakeOptions options;
+  options.degree = scene.diffuse.order;
+  options.cells = scene.diffuse.cells;
+  options.photons = scene.diffuse.photons;
+  options.seed = scene.diffuse.seed;
+  return options;
+}
+
+DiffuseReport diffuse_report(const std::vector<DiffuseBand>& bands, const DiffuseBakeOptions& options,
+                             const DiffuseField& field, int voxels_per_cell, const DiffuseBakeStats& stats,
+                             double wall_seconds) {
+  DiffuseReport r;
+  r.done = true;
+  r.order = options.degree;
+  r.cells = field.cells;
+  r.voxels_per_cell = voxels_per_cell;
+  r.photons_per_band = options.photons;
+  for (const DiffuseBand& b : bands) r.bands += b.albedo > 0;
+  r.seconds = stats.seconds;
+  r.wall_seconds = wall_seconds;
+  r.noise = stats.noise;
+  r.collisions = stats.counters.collisions;
+  r.crossings = stats.counters.crossings;
+  r.capped = stats.counters.capped;
+  r.field_bytes = stats.field_bytes;
+  r.work_bytes = stats.work_bytes;
+  return r;
+}
+
+std::unique_ptr<Progress> diffuse_progress(const std::vector<DiffuseBand>& bands, const DiffuseBakeOptions& options,
+                                           const RenderOptions& o) {
+  if (!o.progress || o.backend != Backend::Cpu) return nullptr;
+  size_t baked = 0;
+  for (const DiffuseBand& b : bands) baked += b.albedo > 0;
+  return std::make_unique<Progress>("diffuse", options.photons * baked);
 }
 
 }  // namespace nebula::pipeline_detail

@@ -2,14 +2,22 @@
 // Internal to pipeline/: what every renderer's run derives from the scene the
 // same way (the start of its report, the image metadata, drawn stars).
 #include <chrono>
+#include <memory>
 #include <string>
 
 #include "core/camera.h"
 #include "core/image.h"
+#include "diffuse/diffuse_bake.h"
 #include "imageio/image_output.h"
 #include "pipeline/run_report.h"
 #include "pipeline/scene_bands.h"
+#include "pipeline/table_source.h"
 #include "scene/scene.h"
+
+namespace nebula {
+struct RenderOptions;
+class Progress;
+}  // namespace nebula
 
 namespace nebula::pipeline_detail {
 
@@ -31,5 +39,19 @@ ImageMetadata scene_metadata(const Scene& scene, const SceneBands& bands, const 
 // is set (raycast/point_stars.h), for 3D grids.
 void draw_scene_stars(const Scene& scene, const SceneBands& bands, const Camera& camera, double exposure,
                       Image& image);
+
+// The diffuse bake's bands (albedo 0 where a band has no table) and options
+// (render.diffuse_*), the same for 3D grids and axial maps.
+std::vector<DiffuseBand> diffuse_bands(const SceneBands& bands, const BandTables& tables);
+DiffuseBakeOptions diffuse_options(const Scene& scene);
+// The report's account of a finished bake (wall: its whole time).
+DiffuseReport diffuse_report(const std::vector<DiffuseBand>& bands, const DiffuseBakeOptions& options,
+                             const DiffuseField& field, int voxels_per_cell, const DiffuseBakeStats& stats,
+                             double wall_seconds);
+// What an image's light between voxels (or cells) came from, for its metadata.
+std::string multiple_scattering_text(const RunReport& r);
+// A progress bar over the bake's photons on the CPU (null otherwise).
+std::unique_ptr<Progress> diffuse_progress(const std::vector<DiffuseBand>& bands, const DiffuseBakeOptions& options,
+                                           const RenderOptions& o);
 
 }  // namespace nebula::pipeline_detail

@@ -3,7 +3,9 @@
 #include <chrono>
 #include <memory>
 
+#include "axial/axial_diffuse.h"
 #include "core/error.h"
+#include "pipeline/axial_map_source.h"
 #include "core/progress.h"
 #include "pipeline/render_scene.h"
 #include "pipeline/run_setup.h"
@@ -13,10 +15,39 @@ namespace nebula {
 
 using namespace pipeline_detail;
 
+namespace {
+
+// An axial map as the truth traces it: voxelized in its own frame (the axis
+// along z from 0; axial/axial_diffuse.h, each voxel the mean of its texels),
+// with the stars and the camera moved into that frame by the same rigid
+// motion, which changes no image.
+struct AxialFrame {
+  DensityGrid density;
+  std::vector<std::vector<float>> emission;
+  Vec3 origin, rows[3];  // world -> frame: p' = R (p - origin), R's rows
+  Vec3 point(Vec3 p) const { return vector(p - origin); }
+  Vec3 vector(Vec3 v) const { return {dot(rows[0], v), dot(rows[1], v), dot(rows[2], v)}; }
+};
+
+AxialFrame axial_frame(const Scene& scene, int voxels) {
+  if (voxels < 8 || voxels > 2048) throw ParameterError("axial_voxels", "must be 8 to 2048, got " + std::to_string(voxels));
+  const AxialMap map = build_axial_map(scene);
+  AxialFrame f;
+  const float longest = std::max(map.length(), 2.0f * map.radius());
+  f.density = voxelize_axial_frame(map, longest / float(voxels), &f.emission);
+  f.origin = map.origin;
+  Vec3 p, q;
+  orthonormal_frame(map.axis, p, q);
+  f.rows[0] = p;
+  f.rows[1] = cross(map.axis, p);  // (p, axis x p, axis) is right-handed: no mirror image
+  f.rows[2] = map.axis;
+  return f;
+}
+
+}  // namespace
+
 TruthRenderOutput truth_scene(const Scene& scene, const TruthOptions& o) {
   const auto start = std::chrono::steady_clock::now();
-  if (scene.axial)
-    throw Error(scene.path + ": axial: the ground truth traces 3D grids only; an axial map has none to trace");
   validate_scene(scene);
   const Camera camera = make_camera(scene.camera);
   const SceneBands sb = scene_bands(scene);
@@ -27,6 +58,19 @@ TruthRenderOutput truth_scene(const Scene& scene, const TruthOptions& o) {
     in.bands.push_back(TruthBand{sb.bands[b], scene.emission.empty() ? nullptr : &scene.emission[b]});
   in.stars = sb.stars;
   in.camera = camera;
+  AxialFrame frame;
+  if (scene.axial) {
+    frame = axial_frame(scene, o.axial_voxels);
+    in.density = &frame.density;
+    for (size_t b = 0; b < sb.bands.size(); ++b)
+      in.bands[b].emission = frame.emission.empty() ? nullptr : &frame.emission[b];
+    for (StarLight& s : in.stars) s.position = frame.point(s.position);
+    CameraSettings cs = scene.camera;
+    cs.position = frame.point(cs.position);
+    cs.look_at = frame.point(cs.look_at);
+    cs.up = frame.vector(cs.up);
+    in.camera = make_camera(cs);
+  }
   in.exposure = static_cast<float>(scene.camera.exposure);
   in.spp = o.spp;
   in.seed = o.seed;
@@ -42,22 +86,27 @@ TruthRenderOutput truth_scene(const Scene& scene, const TruthOptions& o) {
   if (bar) bar->finish();
   // Stars seen directly: the same deterministic drawing as the fast renderer
   // (exact transmittance, a Gaussian PSF); no variance.
-  draw_scene_stars(scene, sb, camera, scene.camera.exposure, result.image);
+  if (!scene.axial) draw_scene_stars(scene, sb, camera, scene.camera.exposure, result.image);
 
   TruthRenderOutput out;
   out.image = std::move(result.image);
   out.variance = std::move(result.variance);
   const std::string transmittance = o.exact_transmittance ? "exact" : "ratio";
+  const std::string traced =
+      scene.axial ? " on the map voxelized to " + std::to_string(frame.density.shape.nx) + "x" +
+                        std::to_string(frame.density.shape.ny) + "x" + std::to_string(frame.density.shape.nz)
+                  : "";
   const std::string mode = "truth spp " + std::to_string(o.spp) + " seed " + std::to_string(o.seed) + " " +
                            transmittance + " transmittance" + (o.equiangular ? " equiangular" : "") +
-                           (o.max_orders ? " orders<=" + std::to_string(o.max_orders) : "");
+                           (o.max_orders ? " orders<=" + std::to_string(o.max_orders) : "") + traced;
   out.metadata = scene_metadata(scene, sb, scene.camera, mode);
   out.variance_metadata = out.metadata;
   out.variance_metadata.units = "(L_sun pc^-2 sr^-1 x exposure)^2, variance of the pixel mean";
   RunReport& r = out.report;
   r = begin_report(scene, sb, "truth", o.backend);
   r.mode = mode;
-  r.truth = TruthReport{o.spp, o.seed, o.max_orders, transmittance, o.equiangular, result.paths, result.counters};
+  r.truth = TruthReport{o.spp, o.seed, o.max_orders, transmittance, o.equiangular, result.paths, result.counters,
+                        frame.density.shape};
   r.render_seconds = result.seconds;
   r.total_seconds = seconds_since(start);
   return out;

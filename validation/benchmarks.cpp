@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "axial/axial_bake.h"
+#include "axial/axial_diffuse.h"
 #include "axial/axial_renderer.h"
 #include "core/philox.h"
 #include "illumination/optical_depth_bake.h"
@@ -313,7 +314,7 @@ TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int 
 void bench_axial(Backend backend, int map_size, int width, int height, int repeats, float step_texels,
                  const std::vector<std::string>& maps, const std::vector<int>& inclinations, bool star,
                  const std::function<void(const AxialBenchRow&)>& on_row, bool step_aside,
-                 std::vector<AxialSkip> modes) {
+                 std::vector<AxialSkip> modes, bool diffuse) {
   if (modes.empty()) modes = axial_skip_modes();
   modes.erase(std::remove(modes.begin(), modes.end(), AxialSkip::Naive), modes.end());
   modes.insert(modes.begin(), AxialSkip::Naive);
@@ -339,6 +340,21 @@ void bench_axial(Backend backend, int map_size, int width, int height, int repea
     if (star) {
       depth = bake_axial_star_depths(map.nx, map.nr, map.texel, map.tau_v, {0.5f}, backend).tau_v;
       in.stars.push_back(BakedStar{{centre, {1.0f, 1.0f, 1.0f}}, &depth[0]});
+    }
+    DiffuseField field;
+    double bake_ms = 0;
+    if (star && diffuse) {
+      std::vector<DiffuseBand> bands;
+      for (const AxialRenderBand& b : in.bands) {
+        DiffuseBand d;
+        static_cast<Band&>(d) = b;
+        d.table = &table;
+        bands.push_back(d);
+      }
+      const auto t0 = std::chrono::steady_clock::now();
+      field = bake_axial_diffuse(map, bands, {static_cast<const StarLight&>(in.stars[0])}, DiffuseBakeOptions{}, backend);
+      bake_ms = 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      in.diffuse = &field;
     }
     in.step = step_texels * texel;
     in.step_aside = step_aside;
@@ -376,6 +392,7 @@ void bench_axial(Backend backend, int map_size, int width, int height, int repea
         row.inclination_deg = inc;
         row.median_ms = 1e3 * median_of(times);
         row.samples = stats.samples;
+        row.diffuse_bake_ms = bake_ms;
         row.ran = to_string(stats.skip_used);
         if (mode == AxialSkip::Naive) {
           naive = image;

@@ -134,6 +134,7 @@ struct AxialBenchRow {
   double speedup = 0;         // naive's median / this mode's
   double max_difference = 0;  // largest |pixel - naive pixel| over naive's peak (0: bit-identical)
   uint64_t samples = 0;       // samples the rays stepped through (CPU only; 0 on the GPU)
+  double diffuse_bake_ms = 0; // the map's diffuse field, baked once per map (with `diffuse`; 0 without)
 };
 
 // The thesis' Tables 5.1-5.5 (Khalass 2021): each synthetic map of
@@ -145,10 +146,12 @@ struct AxialBenchRow {
 // axis at the map's centre lights the dust (full physics, a = g = 0.6, three
 // bands); without it, emission-absorption only. Rows go to on_row as they come.
 // step_aside false runs the skip code even on maps without empty texels (to
-// measure its overhead there).
+// measure its overhead there). `diffuse` (with a star) adds the map's diffuse
+// field (axial/axial_diffuse.h: degree 3, 64 cells, 2^20 photons per band),
+// baked once per map.
 void bench_axial(Backend backend, int map_size, int width, int height, int repeats, float step_texels,
                  const std::vector<std::string>& maps, const std::vector<int>& inclinations, bool star,
                  const std::function<void(const AxialBenchRow&)>& on_row, bool step_aside = true,
-                 std::vector<AxialSkip> modes = {});
+                 std::vector<AxialSkip> modes = {}, bool diffuse = false);
 
 }  // namespace nebula

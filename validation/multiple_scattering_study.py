@@ -28,7 +28,7 @@ sys.path.insert(0, os.path.join(ROOT, "validation"))
 from accuracy_report import write_densities  # noqa: E402  (the layer and wedge grids)
 
 SCENES = ["fig12_reference", "thin_nebula", "thick_nebula", "layer_front", "layer_behind", "wedge", "sphere_tau1",
-          "sphere_tau5"]
+          "sphere_tau5", "axial_lopsided", "axial_lopsided_thick"]
 METHODS = {
     "diffuse (default)": [],
     "pyramid 1 level": ["--levels", "1"],
