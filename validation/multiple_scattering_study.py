@@ -2,7 +2,7 @@
 """The fast renderer's multiple scattering against the ground truth, over albedo and g.
 
 For every scene (the Fig. 12 reference, the five validation scenes, uniform spheres of
-radial optical depth 1 and 5), every albedo a and every Henyey-Greenstein g, renders the
+radial optical depth 1 and 5, and two axial maps lit by a star on their axis), every albedo a and every Henyey-Greenstein g, renders the
 truth (`nebula truth --equiangular`) and the fast renderer in each way of adding the light
 scattered between voxels (the diffuse field, the default; the 2005 pyramid with 1 to 3
 levels; none), and writes per method a table of the bias Sigma(fast - truth)/Sigma truth
@@ -99,6 +99,8 @@ def main():
                        "--force", "-o", truth] + size + dust)
                 truth_seconds = time.time() - t0
                 for method in methods:
+                    if scene.startswith("axial") and method.startswith("pyramid"):
+                        continue  # the pyramid is built from 3D grids; axial maps refuse it
                     out = os.path.join(args.work, f"fast_{tag}_{method.split()[0]}{method.split()[-1]}.h5")
                     t0 = time.time()
                     r.run(["render", path, "--backend", r.backend, "-q", "--force", "-o", out] + size + dust +
