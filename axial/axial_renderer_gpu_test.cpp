@@ -77,10 +77,10 @@ TEST(AxialRendererGpu, SkippingModesMatchNaiveAndTheCpu) {
   }
 }
 
-// The axial diffuse field baked on the GPU is the CPU's (the 3D bake's
-// fixed-point sums do not depend on the order of the additions; the ring
-// averages run on the host), and the march with it follows the CPU's with
-// the bounds above, in every skipping mode.
+// The axial diffuse field baked on the GPU agrees with the CPU's within a
+// fraction of its noise (the photons' paths differ by float contraction, as
+// in diffuse_gpu_tests; the ring averages run on the host), and the march
+// with it follows the CPU's with the bounds above, in the skipping modes.
 TEST(AxialRendererGpu, DiffuseFieldMatchesTheCpu) {
   std::string why;
   if (!gpu_available(&why)) GTEST_SKIP() << why;
@@ -97,11 +97,19 @@ TEST(AxialRendererGpu, DiffuseFieldMatchesTheCpu) {
     o.photons = 1u << 16;
     o.cells = 24;
     const StarLight star{s.inputs.stars[0].position, s.inputs.stars[0].power};
-    const DiffuseField cpu_field = bake_axial_diffuse(s.map, bands, {star}, o, Backend::Cpu);
+    AxialDiffuseStats cpu_stats;
+    const DiffuseField cpu_field = bake_axial_diffuse(s.map, bands, {star}, o, Backend::Cpu, &cpu_stats);
     const DiffuseField gpu_field = bake_axial_diffuse(s.map, bands, {star}, o, Backend::Cuda);
     ASSERT_EQ(cpu_field.packed.size(), gpu_field.packed.size());
-    for (size_t i = 0; i < cpu_field.packed.size(); ++i)
-      ASSERT_EQ(cpu_field.packed[i], gpu_field.packed[i]) << name << " coefficient " << i;
+    double diff = 0, norm = 0;
+    for (size_t i = 0; i < cpu_field.packed.size(); ++i) {
+      diff += std::pow(double(cpu_field.packed[i]) - gpu_field.packed[i], 2);
+      norm += std::pow(double(cpu_field.packed[i]), 2);
+    }
+    const double rel = std::sqrt(diff / norm);
+    std::printf("%s: axial field CPU-GPU relative L2 difference %.3g (one 3D cell's noise %.3g)\n", name.c_str(), rel,
+                cpu_stats.bake.noise[1]);
+    EXPECT_LT(rel, 0.25 * cpu_stats.bake.noise[1]) << name;
     s.inputs.diffuse = &cpu_field;
     for (int inc : {30, 90}) {
       s.inputs.camera = s.view(inc, 64, 6.0f);
