@@ -1,5 +1,6 @@
 // The fast renderer on a 3D grid: bands, tables, one bake per star, the
 // pyramid's coarse levels, then the frame (raycast/, multires/).
+#include <algorithm>
 #include <chrono>
 #include <memory>
 #include <string>
@@ -45,6 +46,11 @@ PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o) {
                                               " allows (the coarsest level keeps 2 voxels)");
   if (!(o.smooth_step == 0 || o.smooth_step >= 1e-3f))
     throw ParameterError("smooth_step", "step in voxels, at least 1e-3 (0: exact)");
+  // A step longer than the grid samples nothing of it: an all-zero image.
+  const int longest = std::max({shape.nx, shape.ny, shape.nz});
+  if (!(o.smooth_step <= float(longest)))
+    throw ParameterError("smooth_step", "is " + to_text(o.smooth_step) + "; must be at most " + std::to_string(longest) +
+                                            " voxels, the grid's longest side (0: exact)");
 
   PreparedGrid p;
   p.scene = &scene;

@@ -82,7 +82,11 @@ BandTables resolve_tables(const Scene& scene, const TableOptions& options) {
       auto found = by_file.find(file);
       if (found == by_file.end()) {
         const auto t0 = std::chrono::steady_clock::now();
-        tables.push_back(std::make_shared<const ScatteringTable>(read_table(file)));
+        try {
+          tables.push_back(std::make_shared<const ScatteringTable>(read_table(file)));
+        } catch (const Error& e) {
+          throw Error(scene.path + ": dust.tables." + scene.bands[b] + ": " + e.what());
+        }
         out.report.push_back({tables.back()->albedo, tables.back()->g, {}, TableOrigin::File, file, seconds_since(t0)});
         found = by_file.emplace(file, out.report.size() - 1).first;
       }

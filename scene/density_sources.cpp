@@ -372,9 +372,15 @@ DensityGrid load_density_fits(const std::string& path, double voxel_size_pc) {
     if (have_pix != 3 || have_val != 3)
       throw Error(what + ": give CRPIXi and CRVALi on all three axes, or none (origin 0)");
     const double v = grid.shape.voxel;
-    grid.shape.origin = Vec3{float(crval[0] + (0.5 - crpix[0]) * v),
-                             float(crval[1] + (0.5 - crpix[1]) * v),
-                             float(crval[2] + (0.5 - crpix[2]) * v)};
+    double origin[3];
+    for (int a = 0; a < 3; ++a) {
+      origin[a] = crval[a] + (0.5 - crpix[a]) * v;
+      if (!(std::fabs(origin[a]) <= 1e30))
+        throw Error(what + ": CRVAL" + std::to_string(a + 1) + " = " + to_text(crval[a]) + " and CRPIX" +
+                    std::to_string(a + 1) + " = " + to_text(crpix[a]) + " put the grid's corner at " +
+                    to_text(origin[a]) + " pc, beyond 1e30 pc (single precision)");
+    }
+    grid.shape.origin = Vec3{float(origin[0]), float(origin[1]), float(origin[2])};
   }
 
   try {
