@@ -75,3 +75,13 @@ refused(step_texels "axial.step_texels" render axial.toml -o out.h5 -q --backend
 if(EXISTS ${WORK}/out.h5)
   message(FATAL_ERROR "a refused render wrote out.h5")
 endif()
+
+# Item 4: the run's memory is estimated before anything is allocated (these
+# ended in "internal error: std::bad_alloc").
+refused(image_memory "the limit of" render small.toml -o out.h5 -q --backend cpu --width 65536 --height 65536)
+refused(tau_bins_memory "--tau-bins: " tabulate --tau-bins 2000000000 --photons 2 --backend cpu -q -o bad.h5)
+run(tabulate --tau-bins 2000000000 --photons 2 --backend cpu -q -o bad.h5)
+string(FIND "${err}" "the limit of" at)
+if(at EQUAL -1)
+  message(FATAL_ERROR "tau_bins_memory: no figure and limit: ${err}")
+endif()

@@ -37,6 +37,7 @@ std::string mode_of(const RenderOptions& o) {
 PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o) {
   if (scene.axial) throw Error(scene.path + ": axial: an axial scene has no 3D grid (render it with render_scene)");
   validate_scene(scene);
+  check_run_memory(scene, RunKind::Fast);
   const GridShape& shape = scene.density.shape;
   const int most_levels = max_pyramid_levels(shape);
   if (scene.pyramid_levels > most_levels)

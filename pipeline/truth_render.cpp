@@ -18,6 +18,7 @@ TruthRenderOutput truth_scene(const Scene& scene, const TruthOptions& o) {
   if (scene.axial)
     throw Error(scene.path + ": axial: the ground truth traces 3D grids only; an axial map has none to trace");
   validate_scene(scene);
+  check_run_memory(scene, RunKind::Truth);
   const Camera camera = make_camera(scene.camera);
   const SceneBands sb = scene_bands(scene);
 
