@@ -96,7 +96,7 @@ struct GridNeeds {
 
 // Opens `path`, checks `dataset` is a numeric array of the wanted rank that
 // fits in memory, reads voxel_size/origin when present and the values as float.
-Hdf5Grid read_hdf5_grid(const std::string& path, const std::string& dataset, const GridNeeds& needs = {}) {
+Hdf5Grid read_hdf5_grid_here(const std::string& path, const std::string& dataset, const GridNeeds& needs) {
   const int want_rank = needs.rank;
   require_readable(path);
   const std::string what = path + ": dataset '" + dataset + "'";
@@ -182,6 +182,12 @@ Hdf5Grid read_hdf5_grid(const std::string& path, const std::string& dataset, con
   if (H5Dread(set.get(), H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, grid.values.data()) < 0)
     throw Error(what + ": cannot read the values");
   return grid;
+}
+
+// A user's file: read in a child first, which survives libhdf5's crashes.
+Hdf5Grid read_hdf5_grid(const std::string& path, const std::string& dataset, const GridNeeds& needs = {}) {
+  hdf5io::read_in_child_first(path, [&] { read_hdf5_grid_here(path, dataset, needs); });
+  return read_hdf5_grid_here(path, dataset, needs);
 }
 
 // ---------------------------------------------------------------- FITS
