@@ -487,5 +487,13 @@ TEST_F(DensityFiles, TruncatedFileIsRefused) {
   expect_error([&] { load_density_hdf5(path("cut.h5")); }, {"cut.h5"});
 }
 
+// Issue 17, a fuzz finding (scripts/fuzz.sh): a 2 KB density file whose
+// damaged metadata makes libhdf5 ask malloc for 2^51 bytes in H5C_protect.
+// Whatever libhdf5 does with it, the loader ends in one line naming the file.
+TEST_F(DensityFiles, FuzzFindingHugeMetadataAllocation) {
+  const std::string file = std::string(NEBULA_SCENES_DIR) + "/../fuzz/findings/density_hdf5_huge_metadata_alloc.h5";
+  expect_error([&] { load_density_hdf5(file); }, {"density_hdf5_huge_metadata_alloc.h5"});
+}
+
 }  // namespace
 }  // namespace nebula

@@ -22,8 +22,11 @@ for loader in "${loaders[@]}"; do
   work=build-fuzz/corpus/$loader
   rm -rf "$work" && mkdir -p "$work" && cp fuzz/corpus/"$loader"/* "$work"/
   echo "fuzz: $loader for ${seconds}s"
-  build-fuzz/fuzz/fuzz_"$loader" -max_total_time="$seconds" -rss_limit_mb=4096 -max_len=65536 \
-    -artifact_prefix=build-fuzz/artifacts/"$loader"- "$work" 2>&1 | grep -E "^#[0-9]+ +DONE|ERROR|SUMMARY|Test unit written" || true
-  [ "${PIPESTATUS[0]}" -eq 0 ] || status=1
+  log=build-fuzz/artifacts/"$loader".log
+  if ! build-fuzz/bin/fuzz_"$loader" -max_total_time="$seconds" -rss_limit_mb=4096 -max_len=65536 \
+      -artifact_prefix=build-fuzz/artifacts/"$loader"- "$work" >"$log" 2>&1; then
+    status=1
+  fi
+  grep -E "^Done [0-9]+ runs|ERROR|SUMMARY|Test unit written" "$log" || true
 done
 exit $status
