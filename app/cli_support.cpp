@@ -27,6 +27,17 @@ void check_output_path(const std::string& option, const std::string& path, bool 
     throw Error(option + ": cannot write into folder " + dir.string() + " (permission denied)");
 }
 
+void check_not_an_input(const std::string& option, const std::string& path, const std::vector<SceneInput>& inputs) {
+  namespace fs = std::filesystem;
+  for (const SceneInput& input : inputs) {
+    std::error_code ec;
+    if (fs::equivalent(path, input.path, ec))  // false (with ec set) when either does not exist
+      throw Error(option + ": " + path + " is " +
+                  (input.key == "scene" ? "the scene file" : "the scene's input " + input.key + " (" + input.path + ")") +
+                  "; writing it would destroy an input, choose another output");
+  }
+}
+
 void check_image_output(const std::string& option, const std::string& path, bool overwrite) {
   try {
     check_image_format(path);
@@ -56,7 +67,7 @@ Backend parse_backend(const std::string& s, const std::string& option) {
   if (s == "cpu") return Backend::Cpu;
   if (s == "cuda" || s == "gpu") {
     std::string why;
-    if (!gpu_available(&why)) throw Error(option + ": cuda requested but " + why);
+    if (!gpu_available(&why)) throw Error(option + ": " + s + " requested but " + why);
     return Backend::Cuda;
   }
   if (s == "auto") return gpu_available() ? Backend::Cuda : Backend::Cpu;
@@ -81,10 +92,13 @@ Scene load_scene_options(const std::string& command, const SceneOptions& o) {
   if (o.demo == !o.path.empty()) throw Error(command + ": give a SCENE.toml or --demo (one of them)");
   if (o.demo && !o.overrides.empty())
     throw Error("--set: the demo takes no overrides; copy scenes/demo.toml and pass it instead");
-  if (o.width < 0 || o.height < 0) throw Error("--width/--height: must be positive");
+  for (const auto& [option, value] : {std::pair<const char*, int>{"--width", o.width}, {"--height", o.height}})
+    if (value != -1 && !(value >= 1 && value <= kMaxCameraPixels))
+      throw Error(std::string(option) + ": is " + std::to_string(value) + "; must be 1 to " +
+                  std::to_string(kMaxCameraPixels) + " pixels");
   Scene scene = o.demo ? demo_scene() : load_scene(o.path, o.overrides);
-  if (o.width > 0) scene.camera.width = o.width;
-  if (o.height > 0) scene.camera.height = o.height;
+  if (o.width != -1) scene.camera.width = o.width;
+  if (o.height != -1) scene.camera.height = o.height;
   return scene;
 }
 

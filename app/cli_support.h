@@ -20,6 +20,11 @@ namespace nebula::app {
 // naming the option and the path.
 void check_output_path(const std::string& option, const std::string& path, bool overwrite);
 
+// Refuses an output that is one of the files the run reads (the same file by
+// device and inode, whatever its name: std::filesystem::equivalent), with or
+// without --force. Throws Error naming the option, the path and the input's key.
+void check_not_an_input(const std::string& option, const std::string& path, const std::vector<SceneInput>& inputs);
+
 // check_output_path, and a format the image writer cannot write here.
 void check_image_output(const std::string& option, const std::string& path, bool overwrite);
 
@@ -39,7 +44,7 @@ struct SceneOptions {
   std::string path;
   bool demo = false;
   std::vector<std::string> overrides;
-  int width = 0, height = 0;
+  int width = -1, height = -1;  // -1: not given (the scene's)
 };
 // Registers SCENE, --demo, --set (repeatable, one value each: a scene file
 // after it is never taken for another override), --width and --height.

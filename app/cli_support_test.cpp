@@ -7,6 +7,8 @@
 #include <fstream>
 
 #include "core/error.h"
+#include "scene/scene_file.h"
+#include "scene/test_files.h"
 
 namespace nebula::app {
 namespace {
@@ -53,6 +55,31 @@ TEST(NamingOptions, RewordsParameterErrors) {
   EXPECT_EQ(message([] { throw ParameterError("render.levels", "9 exceeds the 6"); }), "render.levels: 9 exceeds the 6");
   EXPECT_EQ(message([] { throw Error("plain"); }, "a.toml"), "plain");
   EXPECT_EQ(message([] {}), "no error");
+}
+
+// Issue 17: -o naming the scene's density file (by any name) is refused, even
+// with --force; a file that is no input passes.
+class OutputInput : public nebula::testing::TempDirTest {};
+
+TEST_F(OutputInput, RefusesTheDensityFileByAnyName) {
+  nebula::testing::H5Dataset set;
+  set.dims = {2, 2, 2};
+  set.values.assign(8, 0.5);
+  set.voxel_size = 0.1;
+  nebula::testing::write_h5(path("dens.h5"), {set});
+  const std::string scene_path = write_text(
+      "scene.toml", "[density]\nfile = \"dens.h5\"\n[[stars]]\nposition = [0.1, 0.1, 0.1]\nluminosity_lsun = 1\n"
+                    "class = \"G2V\"\n[camera]\nposition = [0.1, -3, 0.1]\nlook_at = [0.1, 0.1, 0.1]\n");
+  const Scene scene = load_scene(scene_path);
+  nebula::testing::expect_error([&] { check_not_an_input("-o", path("dens.h5"), scene.inputs); },
+                                {"-o", "dens.h5", "density.file"});
+  std::filesystem::create_hard_link(path("dens.h5"), path("other_name.h5"));
+  nebula::testing::expect_error([&] { check_not_an_input("-o", path("other_name.h5"), scene.inputs); },
+                                {"-o", "other_name.h5", "density.file"});
+  nebula::testing::expect_error([&] { check_not_an_input("-o", scene_path, scene.inputs); }, {"the scene file"});
+  std::ofstream(path("image.h5")) << "x";
+  EXPECT_NO_THROW(check_not_an_input("-o", path("image.h5"), scene.inputs));
+  EXPECT_NO_THROW(check_not_an_input("-o", path("new.h5"), scene.inputs));
 }
 
 }  // namespace

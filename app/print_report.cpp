@@ -69,9 +69,11 @@ void print_computed(const RunReport& r) {
     std::printf("  map: %s, %d x %d texels of %g pc, %zu emission plane(s), height-map max %d, %g s\n",
                 a.source.c_str(), a.nx, a.nr, a.texel_pc, a.emission_planes, a.height_max, a.build_seconds);
   }
-  for (const TableReport& t : r.tables)
+  for (const TableReport& t : r.tables) {
+    if (!t.warning.empty()) std::fprintf(stderr, "nebula: warning: %s\n", t.warning.c_str());
     std::printf("  table a=%g g=%g for %s: %s %s (%.3g s)\n", t.albedo, t.g, joined(t.bands).c_str(),
                 to_string(t.origin), t.path.c_str(), t.seconds);
+  }
   if (r.truth) return;
   if (r.bake.done)
     std::printf("  bake: %zu star(s)%s x %llu %s, %g s\n", r.bake.stars, r.axial ? " on the axis" : "",

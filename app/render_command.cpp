@@ -30,6 +30,8 @@ void run_render(const Options& o) {
   if (o.levels > 0) scene.multiple_scattering = MultipleScattering::Pyramid;  // levels are the pyramid's
   const std::string out = o.out.empty() ? scene.output : o.out;
   check_image_output("-o", out, o.force);
+  check_not_an_input("-o", out, scene.inputs);
+  check_run_memory(scene, RunKind::Fast);
   RenderOptions options;
   options.backend = parse_backend(o.backend);
   options.table_photons = parse_count("--table-photons", o.table_photons, 1000, double(kMaxPhotonsPerRow));

@@ -46,6 +46,8 @@ void run_truth(const Options& o) {
   const std::string var_out = variance_path(o.out);
   check_image_output("-o", o.out, o.force);
   check_output_path("-o (variance)", var_out, o.force);
+  check_not_an_input("-o", o.out, scene.inputs);
+  check_not_an_input("-o (variance)", var_out, scene.inputs);
   options.backend = parse_backend(o.backend);
   naming_options(names, [&] {
     const TruthRenderOutput result = truth_scene(scene, options);

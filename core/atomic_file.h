@@ -20,6 +20,11 @@ std::string sync_file(const std::string& path);
 // An empty file TARGET.tmp-PID-N beside the target, removed again unless
 // published. We create it ourselves so an unwritable folder fails with
 // errno's plain reason ("Permission denied") rather than a format library's.
+// SIGINT, SIGTERM and SIGHUP remove every live temporary before the process
+// dies of the signal (the handlers are installed on the first temporary, only
+// where the signal has its default disposition); and creating one removes the
+// stale TARGET.tmp-PID-N of the same target left by processes that no longer
+// exist.
 class TemporaryFile {
  public:
   // Throws Error("cannot write TARGET: <errno text>") when it cannot be created.
@@ -37,6 +42,7 @@ class TemporaryFile {
   std::string target_;
   std::string path_;
   bool published_ = false;
+  int slot_ = -1;  // in the signal handler's table, or -1
 };
 
 }  // namespace nebula

@@ -36,11 +36,18 @@ std::optional<CameraIssue> camera_issue(const CameraSettings& c) {
   if (!finite(c.position)) return CameraIssue{"position", "must be finite"};
   if (!finite(c.look_at)) return CameraIssue{"look_at", "must be finite"};
   if (!finite(c.up)) return CameraIssue{"up", "must be finite"};
-  // In double: a float cross product of large or nearly parallel vectors loses the answer.
+  // In double: a float dot or cross product of large or nearly parallel vectors loses the answer.
+  auto norm = [](Vec3 v) { return std::sqrt(double(v.x) * v.x + double(v.y) * v.y + double(v.z) * v.z); };
+  if (norm(c.position) > kMaxCameraDistancePc)
+    return CameraIssue{"position", "is " + vec_text(c.position) + ", farther than " + to_text(kMaxCameraDistancePc) +
+                                       " pc from the origin (single precision would lose the view direction)"};
+  if (norm(c.look_at) > kMaxCameraDistancePc)
+    return CameraIssue{"look_at", "is " + vec_text(c.look_at) + ", farther than " + to_text(kMaxCameraDistancePc) +
+                                      " pc from the origin (single precision would lose the view direction)"};
   const double dx = double(c.look_at.x) - c.position.x, dy = double(c.look_at.y) - c.position.y,
                dz = double(c.look_at.z) - c.position.z;
   const double view = std::sqrt(dx * dx + dy * dy + dz * dz);
-  const double scale = std::fmax(1.0, std::sqrt(double(dot(c.position, c.position))));
+  const double scale = std::fmax(1.0, norm(c.position));
   if (!(view > 1e-6 * scale))
     return CameraIssue{"look_at", "equals the position " + vec_text(c.position) + ": the view direction has zero length"};
   const double ux = c.up.x, uy = c.up.y, uz = c.up.z;
@@ -71,6 +78,9 @@ std::optional<CameraIssue> camera_issue(const CameraSettings& c) {
                                      "; a fisheye dome master must be square"};
   if (!(std::isfinite(c.exposure) && c.exposure > 0))
     return CameraIssue{"exposure", "is " + to_text(c.exposure) + "; must be > 0"};
+  if (c.exposure > kMaxCameraExposure)
+    return CameraIssue{"exposure", "is " + to_text(c.exposure) + "; must be at most " + to_text(kMaxCameraExposure) +
+                                       " (radiance is single precision: a larger exposure overflows pixels)"};
   return std::nullopt;
 }
 

@@ -99,6 +99,12 @@ struct CameraSettings {
 };
 
 constexpr int kMaxCameraPixels = 1 << 16;  // per side
+// Radiance is single precision: with stars up to 1e12 L_sun a larger exposure
+// could overflow a pixel to infinity (and NaN after tone mapping).
+constexpr double kMaxCameraExposure = 1e12;
+// Camera points farther than this from the origin (parsecs, about 70 times the
+// observable universe) lose the view direction in single precision.
+constexpr double kMaxCameraDistancePc = 1e12;
 
 // The first setting that makes no camera: its field name as CameraSettings
 // spells it (and a scene file's [camera] table does; "kind" for the

@@ -3,6 +3,7 @@
 // error stack's reason in one line, and one lock for the whole program.
 #include <hdf5.h>
 
+#include <functional>
 #include <mutex>
 #include <string>
 
@@ -45,6 +46,15 @@ std::string with_reason(const std::string& what);
 // Serial HDF5 (1.10 unless built thread-safe) must not be entered from two
 // threads at once; every caller in the program takes this one lock.
 std::mutex& hdf5_mutex();
+
+// libhdf5 1.10 crashes on some damaged files (SIGSEGV in H5F__accum_read, heap
+// overflows under H5Aexists). Every reader of a user's file first runs `read`
+// in a child process (fork): a crash there becomes an Error naming `path`
+// ("the HDF5 library crashed reading it"), an Error there is rethrown here,
+// and only a read that succeeded in the child is done again in this process.
+// Set NEBULA_HDF5_IN_PROCESS=1 to read in this process only (fuzzing,
+// debugging). Call without hdf5_mutex() held; `read` takes it as usual.
+void read_in_child_first(const std::string& path, const std::function<void()>& read);
 
 // HDF5 prints its error stack to stderr by default; we report one line
 // instead. Call with hdf5_mutex() held.

@@ -2,9 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <signal.h>
+
 #include <filesystem>
 #include <string>
 #include <thread>
+
+#include "core/error.h"
 
 namespace nebula::hdf5io {
 namespace {
@@ -54,6 +58,38 @@ TEST(Hdf5Support, ReasonIsTheSystemsText) {
   ASSERT_FALSE(file.valid());
   EXPECT_EQ(hdf5_reason(), "No such file or directory");
   EXPECT_EQ(with_reason("creating a.h5"), "creating a.h5 (No such file or directory)");
+}
+
+}  // namespace
+}  // namespace nebula::hdf5io
+
+namespace nebula::hdf5io {
+namespace {
+
+// Issue 17, item 1: a library crash while reading a user's file becomes a
+// one-line Error naming the file, and this process lives on.
+TEST(ReadInChildFirst, ACrashBecomesAnErrorNamingTheFile) {
+  try {
+    read_in_child_first("damaged.h5", [] { ::raise(SIGSEGV); });
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("damaged.h5"), std::string::npos) << m;
+    EXPECT_NE(m.find("crashed"), std::string::npos) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  }
+}
+
+TEST(ReadInChildFirst, TheChildsErrorIsRethrownAndSuccessReturns) {
+  try {
+    read_in_child_first("bad.h5", [] { throw Error("bad.h5: dataset 'x': not found"); });
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "bad.h5: dataset 'x': not found");
+  }
+  EXPECT_NO_THROW(read_in_child_first("good.h5", [] {}));
+  // The child takes the HDF5 lock as every reader does, without deadlocking.
+  EXPECT_NO_THROW(read_in_child_first("good.h5", [] { const std::lock_guard<std::mutex> lock(hdf5_mutex()); }));
 }
 
 }  // namespace

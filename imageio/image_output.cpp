@@ -1,5 +1,7 @@
 #include "imageio/image_output.h"
 
+#include "hdf5io/hdf5_support.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
@@ -263,7 +265,13 @@ Image read_image(const std::string& path, ImageMetadata* metadata) {
   Image image;
   try {
     switch (format) {
-      case Format::Hdf5: image = read_hdf5(path, &read_metadata); break;
+      case Format::Hdf5:
+        hdf5io::read_in_child_first(path, [&] {
+          ImageMetadata ignored;
+          read_hdf5(path, &ignored);
+        });
+        image = read_hdf5(path, &read_metadata);
+        break;
       case Format::Fits: image = read_fits(path, &read_metadata); break;
       case Format::Exr: image = read_exr(path, &read_metadata); break;
       case Format::Png: break;  // refused above

@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/gpu.h"
+#include "core/memory.h"
 #include "core/math.h"
 
 namespace nebula {
@@ -20,6 +21,11 @@ void validate(const TabulateParams& p) {
   if (p.tau_bins < 2) throw ParameterError("tau_bins", "need at least 2 rows, got " + to_text(p.tau_bins));
   if (p.mu_bins < 2 || p.mu_bins > kMaxMuBins)
     throw ParameterError("mu_bins", "need 2 to " + to_text(kMaxMuBins) + " bins, got " + to_text(p.mu_bins));
+  // Per bin: the tallies (two 64-bit sums), P and its error in double, the
+  // table's float copies; per row a few doubles. Refused before allocating.
+  const double bytes = double(p.tau_bins) * (double(p.mu_bins) * (2 * 8 + 2 * 8 + 2 * 4) + 8 * 8);
+  if (const std::string over = over_memory_limit(bytes); !over.empty())
+    throw ParameterError("tau_bins", to_text(p.tau_bins) + " rows of " + to_text(p.mu_bins) + " bins " + over);
   if (p.photons_per_row < 2 || p.photons_per_row > kMaxPhotonsPerRow)
     throw ParameterError("photons_per_row", "need 2 to 2^30 photons per row, got " + to_text(double(p.photons_per_row)));
   if (!(p.roulette.threshold > 0 && p.roulette.threshold < 1) ||

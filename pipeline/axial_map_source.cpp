@@ -1,5 +1,6 @@
 #include "pipeline/axial_map_source.h"
 
+#include <algorithm>
 #include <cctype>
 #include <filesystem>
 
@@ -83,6 +84,12 @@ AxialMap build_axial_map(const Scene& scene) {
   } else {
     read_image_map(scene, m);
   }
+  // A step longer than the map crosses it in one sample: the march would see
+  // (almost) nothing of it, a wrong image rather than a coarse one.
+  const int map_texels = std::max(m.nx, m.nr);
+  if (!(a.step_texels <= map_texels))
+    throw ParameterError("axial.step_texels", "is " + to_text(a.step_texels) + "; must be at most " +
+                                                  std::to_string(map_texels) + ", the map's larger size in texels");
   m.texel = static_cast<float>(a.length_pc / m.nx);
   m.origin = a.origin;
   m.axis = a.axis;

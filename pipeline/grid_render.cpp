@@ -1,5 +1,6 @@
 // The fast renderer on a 3D grid: bands, tables, one bake per star, the
 // pyramid's coarse levels, then the frame (raycast/, multires/).
+#include <algorithm>
 #include <chrono>
 #include <memory>
 #include <string>
@@ -26,6 +27,7 @@ std::string mode_of(const RenderOptions& o) {
 PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o) {
   if (scene.axial) throw Error(scene.path + ": axial: an axial scene has no 3D grid (render it with render_scene)");
   validate_scene(scene);
+  check_run_memory(scene, RunKind::Fast);
   const GridShape& shape = scene.density.shape;
   const int most_levels = max_pyramid_levels(shape);
   if (scene.pyramid_levels > most_levels)
@@ -35,6 +37,11 @@ PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o) {
                                               " allows (the coarsest level keeps 2 voxels)");
   if (!(o.smooth_step == 0 || o.smooth_step >= 1e-3f))
     throw ParameterError("smooth_step", "step in voxels, at least 1e-3 (0: exact)");
+  // A step longer than the grid samples nothing of it: an all-zero image.
+  const int longest = std::max({shape.nx, shape.ny, shape.nz});
+  if (!(o.smooth_step <= float(longest)))
+    throw ParameterError("smooth_step", "is " + to_text(o.smooth_step) + "; must be at most " + std::to_string(longest) +
+                                            " voxels, the grid's longest side (0: exact)");
 
   PreparedGrid p;
   p.scene = &scene;

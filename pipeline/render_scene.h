@@ -7,6 +7,8 @@
 // bars aside) and names scene keys or option fields in its errors
 // (ParameterError), never command-line options.
 #include <cstdint>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "core/backend.h"
@@ -22,6 +24,21 @@
 #include "scene/scene.h"
 
 namespace nebula {
+
+// What a run will allocate, estimated from the scene before any work: the
+// image(s), the grids, the star bakes, the diffuse field or pyramid levels
+// (the largest parts; small ones such as tables are left out).
+enum class RunKind { Fast, Truth };
+struct RunMemory {
+  double bytes = 0;
+  std::vector<std::pair<std::string, double>> parts;  // what, bytes
+};
+RunMemory estimate_run_memory(const Scene& scene, RunKind kind);
+
+// Throws Error "<scene>: the run needs X, more than the limit of Y (half the
+// physical memory) (parts...)" when the estimate exceeds the limit
+// (core/memory.h). render_scene's grid path and truth_scene call it first.
+void check_run_memory(const Scene& scene, RunKind kind);
 
 struct RenderOptions {
   Backend backend = Backend::Cpu;

@@ -32,6 +32,7 @@ struct TableReport {
   TableOrigin origin = TableOrigin::Cache;
   std::string path;                // the file read, or the cache entry
   double seconds = 0;              // reading or generating it
+  std::string warning;             // a damaged or foreign cache entry that was generated again
 };
 
 struct BakeReport {

@@ -1,6 +1,12 @@
 #include "pipeline/table_source.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <charconv>
 #include <chrono>
+#include <cstring>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -29,23 +35,83 @@ std::string table_cache_dir() {
   return ".nebula-cache/tables";
 }
 
+namespace {
+
+// The shortest text that reads back as exactly `v` (std::to_chars): two
+// different parameters never share a cache entry, and 0.6 stays "0.6".
+std::string exact_text(double v) {
+  char text[64];
+  const auto result = std::to_chars(text, text + sizeof text, v);
+  return std::string(text, result.ptr);
+}
+
+// Why a table read from the cache is not the one asked for, or "".
+std::string mismatch(const ScatteringTable& t, const TabulateParams& p) {
+  const ScatteringTable axes = ScatteringTable::make_axes(p.tau_max, p.tau_bins, p.binning, p.mu_bins);
+  auto differs = [](const std::string& field, const std::string& have, const std::string& want) {
+    return field + " is " + have + ", not " + want;
+  };
+  if (t.albedo != p.albedo) return differs("albedo", exact_text(t.albedo), exact_text(p.albedo));
+  if (t.g != p.g) return differs("g", exact_text(t.g), exact_text(p.g));
+  if (t.tau != axes.tau)
+    return "the tau axis (" + std::to_string(t.tau.size()) + " rows to " +
+           (t.tau.empty() ? std::string("-") : exact_text(t.tau.back())) + ") is not " +
+           std::to_string(p.tau_bins) + " rows to " + exact_text(p.tau_max);
+  if (t.mu_binning != p.binning || t.mu_edges != axes.mu_edges)
+    return "the mu bins are not " + std::to_string(p.mu_bins) + " " + to_string(p.binning) + " bins";
+  if (t.illumination != to_string(p.beam)) return differs("illumination", t.illumination, to_string(p.beam));
+  if (t.photons_per_row != p.photons_per_row)
+    return differs("photons_per_row", std::to_string(t.photons_per_row), std::to_string(p.photons_per_row));
+  if (t.seed != p.seed) return differs("seed", std::to_string(t.seed), std::to_string(p.seed));
+  if (t.forced_first_scattering != p.forced_first_scattering || t.roulette_threshold != p.roulette.threshold ||
+      t.roulette_survival != p.roulette.survival || t.max_orders != p.roulette.max_orders)
+    return "the transport settings (forced first scattering, roulette, order limit) differ";
+  return "";
+}
+
+}  // namespace
+
+std::string table_cache_name(const TabulateParams& p) {
+  return "hg_a" + exact_text(p.albedo) + "_g" + exact_text(p.g) + "_tau" + exact_text(p.tau_max) + "x" +
+         std::to_string(p.tau_bins) + "_" + to_string(p.binning) + std::to_string(p.mu_bins) + "_" +
+         to_string(p.beam) + "_n" + std::to_string(p.photons_per_row) + "_s" + std::to_string(p.seed) + ".h5";
+}
+
 ScatteringTable cached_table(const TabulateParams& p, Backend backend, bool progress, TableOrigin* origin,
-                             std::string* path_out) {
+                             std::string* path_out, std::string* warning) {
   validate(p);
-  std::ostringstream name;
-  name << "hg_a" << p.albedo << "_g" << p.g << "_tau" << p.tau_max << "x" << p.tau_bins << "_"
-       << to_string(p.binning) << p.mu_bins << "_" << to_string(p.beam) << "_n" << p.photons_per_row
-       << "_s" << p.seed << ".h5";
   const std::filesystem::path dir = table_cache_dir();
-  const std::filesystem::path path = dir / name.str();
+  const std::filesystem::path path = dir / table_cache_name(p);
   if (path_out) *path_out = path.string();
   std::error_code ec;
   if (std::filesystem::exists(path, ec)) {
-    if (origin) *origin = TableOrigin::Cache;
-    return read_table(path.string());
+    // An entry is trusted only once read, checked and found to be the table asked for.
+    std::string problem;
+    try {
+      ScatteringTable cached = read_table(path.string());
+      problem = mismatch(cached, p);
+      if (problem.empty()) {
+        if (origin) *origin = TableOrigin::Cache;
+        return cached;
+      }
+    } catch (const Error& e) {
+      problem = e.what();
+    }
+    if (warning)
+      *warning = "table cache: the entry " + path.string() + " is unusable (" + problem + "); generated it again";
   }
   std::filesystem::create_directories(dir, ec);
   if (ec) throw Error("table cache: cannot create " + dir.string() + ": " + ec.message());
+  // Fail before the Monte-Carlo work, not after it, when the entry cannot be written.
+  {
+    const std::string probe = (dir / (".write-probe-" + std::to_string(::getpid()))).string();
+    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
+    if (fd < 0)
+      throw Error("table cache: cannot write into " + dir.string() + " (" + std::strerror(errno) +
+                  "); set NEBULA_CACHE_DIR to a writable folder");
+    ::close(fd);
+    ::unlink(probe.c_str());
+  }
   std::unique_ptr<Progress> bar;
   if (progress)
     bar = std::make_unique<Progress>("table a=" + std::to_string(p.albedo).substr(0, 4) +
@@ -53,7 +119,11 @@ ScatteringTable cached_table(const TabulateParams& p, Backend backend, bool prog
                                      p.photons_per_row * p.tau_bins);
   const ScatteringTable table = to_table(tabulate(p, backend, bar.get()));
   if (bar) bar->finish();
-  write_table(table, path.string(), true);
+  try {
+    write_table(table, path.string(), true);
+  } catch (const Error& e) {
+    throw Error(std::string("table cache: ") + e.what());
+  }
   if (origin) *origin = TableOrigin::Generated;
   return table;
 }
@@ -82,8 +152,12 @@ BandTables resolve_tables(const Scene& scene, const TableOptions& options) {
       auto found = by_file.find(file);
       if (found == by_file.end()) {
         const auto t0 = std::chrono::steady_clock::now();
-        tables.push_back(std::make_shared<const ScatteringTable>(read_table(file)));
-        out.report.push_back({tables.back()->albedo, tables.back()->g, {}, TableOrigin::File, file, seconds_since(t0)});
+        try {
+          tables.push_back(std::make_shared<const ScatteringTable>(read_table(file)));
+        } catch (const Error& e) {
+          throw Error(scene.path + ": dust.tables." + scene.bands[b] + ": " + e.what());
+        }
+        out.report.push_back({tables.back()->albedo, tables.back()->g, {}, TableOrigin::File, file, seconds_since(t0), ""});
         found = by_file.emplace(file, out.report.size() - 1).first;
       }
       entry = found->second;
@@ -102,9 +176,9 @@ BandTables resolve_tables(const Scene& scene, const TableOptions& options) {
         p.binning = AngularBinning::UniformTheta;  // better for forward-peaked dust (docs/tabulator.md)
         p.photons_per_row = options.photons_per_row;
         const auto t0 = std::chrono::steady_clock::now();
-        TableReport r{a, g, {}, TableOrigin::Cache, "", 0};
-        tables.push_back(
-            std::make_shared<const ScatteringTable>(cached_table(p, options.backend, options.progress, &r.origin, &r.path)));
+        TableReport r{a, g, {}, TableOrigin::Cache, "", 0, ""};
+        tables.push_back(std::make_shared<const ScatteringTable>(
+            cached_table(p, options.backend, options.progress, &r.origin, &r.path, &r.warning)));
         r.seconds = seconds_since(t0);
         out.report.push_back(r);
         found = by_parameters.emplace(std::make_pair(a, g), out.report.size() - 1).first;

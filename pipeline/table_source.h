@@ -20,10 +20,18 @@ namespace nebula {
 // ./.nebula-cache/tables.
 std::string table_cache_dir();
 
+// The cache entry's file name: every parameter written exactly (the shortest
+// text that reads back as the same double), so different requests never share one.
+std::string table_cache_name(const TabulateParams& p);
+
 // The cached table for these parameters, generating (and caching) it when
-// absent. `origin` and `path` (may be null) receive where it came from.
+// absent. An entry that cannot be read, or holds another table than the one
+// asked for, is generated again and `warning` (may be null) says so. When the
+// cache folder cannot be written, fails before the Monte-Carlo work with an
+// Error naming the folder. `origin` and `path` (may be null) receive where the
+// table came from.
 ScatteringTable cached_table(const TabulateParams& p, Backend backend, bool progress, TableOrigin* origin,
-                             std::string* path);
+                             std::string* path, std::string* warning = nullptr);
 
 struct TableOptions {
   Backend backend = Backend::Cpu;

@@ -5,7 +5,14 @@
 
 #include <gtest/gtest.h>
 
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 
 #include "scene/scene_file.h"
 #include "scene/test_files.h"
@@ -92,6 +99,80 @@ TEST_F(TableSource, OneFileNamedTwiceIsReadOnceAndABandWithoutAlbedoNeedsNone) {
   EXPECT_EQ(t.per_band[2], nullptr);
   ASSERT_EQ(t.report.size(), 1u);
   EXPECT_EQ(t.report[0].bands, (std::vector<std::string>{"B", "V"}));
+}
+
+// Issue 17, item 3: cache entries are keyed by the exact parameters. Names
+// rounded to 6 digits made g = 0.9999995 reuse the g = 0.9999999 table.
+TEST_F(TableSource, CacheEntriesAreKeyedExactly) {
+  TabulateParams a, b;
+  a.g = 0.9999999;
+  b.g = 0.9999995;
+  EXPECT_NE(table_cache_name(a), table_cache_name(b));
+  b.g = a.g;
+  b.albedo = std::nextafter(a.albedo, 1.0);
+  EXPECT_NE(table_cache_name(a), table_cache_name(b));
+  const BandTables first = resolve(scene("g = 0.9999999"));
+  const BandTables second = resolve(scene("g = 0.9999995"));
+  EXPECT_EQ(second.report[0].origin, TableOrigin::Generated);
+  EXPECT_EQ(second.per_band[0]->g, 0.9999995);
+  EXPECT_NE(first.report[0].path, second.report[0].path);
+}
+
+// Issue 17, item 3: a truncated, empty or foreign entry is generated again
+// with a warning naming the cache; it blocked every later render before.
+TEST_F(TableSource, BadCacheEntriesAreGeneratedAgainWithAWarning) {
+  const BandTables first = resolve(scene("g = 0.5"));
+  ASSERT_EQ(first.report[0].origin, TableOrigin::Generated);
+  const std::string entry = first.report[0].path;
+  const auto size = std::filesystem::file_size(entry);
+  std::filesystem::resize_file(entry, size / 2);
+  const BandTables truncated = resolve(scene("g = 0.5"));
+  EXPECT_EQ(truncated.report[0].origin, TableOrigin::Generated);
+  EXPECT_NE(truncated.report[0].warning.find("table cache"), std::string::npos) << truncated.report[0].warning;
+  EXPECT_NE(truncated.report[0].warning.find(entry), std::string::npos) << truncated.report[0].warning;
+  EXPECT_EQ(std::filesystem::file_size(entry), size);
+  EXPECT_EQ(resolve(scene("g = 0.5")).report[0].origin, TableOrigin::Cache);
+
+  std::ofstream(entry, std::ios::trunc).close();  // empty
+  const BandTables empty = resolve(scene("g = 0.5"));
+  EXPECT_EQ(empty.report[0].origin, TableOrigin::Generated);
+  EXPECT_FALSE(empty.report[0].warning.empty());
+
+  // A valid table of other parameters under this entry's name.
+  table_file("foreign.h5", 0.6, 0.25);
+  std::filesystem::copy_file(path("foreign.h5"), entry, std::filesystem::copy_options::overwrite_existing);
+  const BandTables foreign = resolve(scene("g = 0.5"));
+  EXPECT_EQ(foreign.report[0].origin, TableOrigin::Generated);
+  EXPECT_NE(foreign.report[0].warning.find("g is 0.25, not 0.5"), std::string::npos) << foreign.report[0].warning;
+  EXPECT_EQ(foreign.per_band[0]->g, 0.5);
+}
+
+// Issue 17, item 3: an unwritable cache folder fails before the Monte-Carlo
+// work (it failed after it). Run in a child that is not root (root writes
+// anywhere), with an alarm: the old code spent minutes on these photons.
+TEST_F(TableSource, UnwritableCacheFailsBeforeTheWork) {
+  const std::string cache = path("read_only");
+  std::filesystem::create_directories(cache + "/tables");
+  std::filesystem::permissions(cache + "/tables", std::filesystem::perms(0555));
+  const pid_t child = ::fork();
+  if (child == 0) {
+    ::alarm(20);
+    if (::geteuid() == 0 && (::setgid(65534) != 0 || ::setuid(65534) != 0)) ::_exit(3);
+    setenv("NEBULA_CACHE_DIR", cache.c_str(), 1);
+    TabulateParams p;
+    p.photons_per_row = kMaxPhotonsPerRow;
+    try {
+      cached_table(p, Backend::Cpu, false, nullptr, nullptr);
+    } catch (const Error& e) {
+      const std::string m = e.what();
+      ::_exit(m.find("table cache") != std::string::npos && m.find("read_only") != std::string::npos ? 0 : 1);
+    }
+    ::_exit(2);
+  }
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << "the child died of signal " << WTERMSIG(status) << " (the alarm: it tabulated)";
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "1: the error names no cache folder; 2: no error; 3: could not drop root";
 }
 
 }  // namespace

@@ -49,6 +49,7 @@ AxialFrame axial_frame(const Scene& scene, int voxels) {
 TruthRenderOutput truth_scene(const Scene& scene, const TruthOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   validate_scene(scene);
+  check_run_memory(scene, RunKind::Truth);
   const Camera camera = make_camera(scene.camera);
   const SceneBands sb = scene_bands(scene);
 

@@ -8,12 +8,14 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <mutex>
 #include <string>
 
 #include "core/error.h"
+#include "core/memory.h"
 #include "hdf5io/hdf5_support.h"
 
 namespace nebula {
@@ -26,17 +28,6 @@ std::mutex& fits_lock() {
   return m;
 }
 
-std::string bytes_text(double bytes) {
-  const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
-  int u = 0;
-  while (bytes >= 1024.0 && u < 6) {
-    bytes /= 1024.0;
-    ++u;
-  }
-  char text[48];
-  std::snprintf(text, sizeof text, "%.3g %s", bytes, units[u]);
-  return text;
-}
 
 // Fails early, with the system's reason, when the file cannot be read.
 void require_readable(const std::string& path) {
@@ -95,9 +86,18 @@ struct Hdf5Grid {
   std::vector<float> values;
 };
 
-// Opens `path`, checks `dataset` is a 3D numeric array that fits in memory,
-// reads voxel_size/origin when present and the values as float.
-Hdf5Grid read_hdf5_grid(const std::string& path, const std::string& dataset, int want_rank = 3) {
+// What a caller requires of a grid, checked before its values are allocated
+// (cheap checks first: a small file may claim a huge grid).
+struct GridNeeds {
+  int rank = 3;
+  bool voxel_size = false;                // a density: the attribute must be there
+  const GridShape* shape = nullptr;       // an emission grid: the density's shape
+};
+
+// Opens `path`, checks `dataset` is a numeric array of the wanted rank that
+// fits in memory, reads voxel_size/origin when present and the values as float.
+Hdf5Grid read_hdf5_grid_here(const std::string& path, const std::string& dataset, const GridNeeds& needs) {
+  const int want_rank = needs.rank;
   require_readable(path);
   const std::string what = path + ": dataset '" + dataset + "'";
   std::lock_guard<std::mutex> lock(hdf5io::hdf5_mutex());
@@ -130,6 +130,11 @@ Hdf5Grid read_hdf5_grid(const std::string& path, const std::string& dataset, int
   grid.shape.nx = static_cast<int>(dims[2]);
   grid.shape.ny = static_cast<int>(dims[1]);
   grid.shape.nz = static_cast<int>(dims[0]);
+  if (const GridShape* want = needs.shape;
+      want && (grid.shape.nx != want->nx || grid.shape.ny != want->ny || grid.shape.nz != want->nz))
+    throw Error(what + ": shape " + std::to_string(grid.shape.nx) + " x " + std::to_string(grid.shape.ny) + " x " +
+                std::to_string(grid.shape.nz) + " (nx x ny x nz) differs from the density's " +
+                std::to_string(want->nx) + " x " + std::to_string(want->ny) + " x " + std::to_string(want->nz));
   const hid_t voxel_holder = attribute_holder(set.get(), file.get(), "voxel_size");
   if (voxel_holder >= 0) {
     const double voxel = read_numeric_attribute(voxel_holder, "voxel_size", 1, what)[0];
@@ -139,6 +144,8 @@ Hdf5Grid read_hdf5_grid(const std::string& path, const std::string& dataset, int
                   " must be positive and finite (the voxel edge in parsecs)");
     grid.shape.voxel = static_cast<float>(voxel);
     grid.has_voxel = true;
+  } else if (needs.voxel_size) {
+    throw Error(what + ": missing attribute 'voxel_size' (the voxel edge in parsecs) on the dataset or the file");
   }
   const hid_t origin_holder = attribute_holder(set.get(), file.get(), "origin");
   if (origin_holder >= 0) {
@@ -147,6 +154,24 @@ Hdf5Grid read_hdf5_grid(const std::string& path, const std::string& dataset, int
       if (!std::isfinite(v) || std::fabs(v) > 1e30)
         throw Error(what + ": attribute 'origin' has a non-finite value " + to_text(v));
     grid.shape.origin = Vec3{float(o[0]), float(o[1]), float(o[2])};
+  }
+  // Values the file does not hold: never written, or a contiguous dataset
+  // whose bytes lie (partly) beyond the end of a truncated file.
+  H5D_space_status_t allocated = H5D_SPACE_STATUS_ERROR;
+  if (H5Dget_space_status(set.get(), &allocated) < 0 || allocated == H5D_SPACE_STATUS_NOT_ALLOCATED)
+    throw Error(what + ": holds no values (the dataset was created but never written)");
+  {
+    Handle create(H5Dget_create_plist(set.get()), H5Pclose);
+    const size_t element = H5Tget_size(type.get());
+    if (create.valid() && H5Pget_layout(create.get()) == H5D_CONTIGUOUS && element > 0) {
+      const haddr_t offset = H5Dget_offset(set.get());
+      const long double need = static_cast<long double>(grid.shape.count()) * element;
+      std::error_code ec;
+      const auto file_bytes = std::filesystem::file_size(path, ec);
+      if (!ec && offset != HADDR_UNDEF && static_cast<long double>(offset) + need > file_bytes)
+        throw Error(what + ": its values need " + bytes_text(double(need)) + " but the file ends after " +
+                    bytes_text(double(file_bytes)) + " (truncated?)");
+    }
   }
   try {
     grid.values.resize(grid.shape.count());
@@ -157,6 +182,12 @@ Hdf5Grid read_hdf5_grid(const std::string& path, const std::string& dataset, int
   if (H5Dread(set.get(), H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, grid.values.data()) < 0)
     throw Error(what + ": cannot read the values");
   return grid;
+}
+
+// A user's file: read in a child first, which survives libhdf5's crashes.
+Hdf5Grid read_hdf5_grid(const std::string& path, const std::string& dataset, const GridNeeds& needs = {}) {
+  hdf5io::read_in_child_first(path, [&] { read_hdf5_grid_here(path, dataset, needs); });
+  return read_hdf5_grid_here(path, dataset, needs);
 }
 
 // ---------------------------------------------------------------- FITS
@@ -207,12 +238,7 @@ std::string trimmed_lower(std::string s) {
 
 // ---------------------------------------------------------------- checks
 
-size_t grid_memory_limit_bytes() {
-  const long pages = sysconf(_SC_PHYS_PAGES);
-  const long page_size = sysconf(_SC_PAGE_SIZE);
-  if (pages <= 0 || page_size <= 0) return size_t(1) << 32;  // unknown: assume 8 GiB of memory
-  return static_cast<size_t>(pages) / 2 * static_cast<size_t>(page_size);
-}
+size_t grid_memory_limit_bytes() { return memory_limit_bytes(); }
 
 void check_grid_size(const std::string& what, uint64_t nx, uint64_t ny, uint64_t nz,
                      uint64_t bytes_per_voxel, uint64_t limit_bytes) {
@@ -247,7 +273,9 @@ void check_grid_values(const std::string& what, const GridShape& shape,
 // ---------------------------------------------------------------- loaders
 
 DensityGrid load_density_hdf5(const std::string& path, const std::string& dataset) {
-  Hdf5Grid grid = read_hdf5_grid(path, dataset);
+  GridNeeds needs;
+  needs.voxel_size = true;
+  Hdf5Grid grid = read_hdf5_grid(path, dataset, needs);
   const std::string what = path + ": dataset '" + dataset + "'";
   if (!grid.has_voxel)
     throw Error(what + ": missing attribute 'voxel_size' (the voxel edge in parsecs) on the "
@@ -258,7 +286,9 @@ DensityGrid load_density_hdf5(const std::string& path, const std::string& datase
 
 std::vector<float> load_emission_hdf5(const std::string& path, const std::string& dataset,
                                       const GridShape& density_shape) {
-  Hdf5Grid grid = read_hdf5_grid(path, dataset);
+  GridNeeds needs;
+  needs.shape = &density_shape;
+  Hdf5Grid grid = read_hdf5_grid(path, dataset, needs);
   const std::string what = path + ": dataset '" + dataset + "'";
   const GridShape& s = grid.shape;
   if (s.nx != density_shape.nx || s.ny != density_shape.ny || s.nz != density_shape.nz)
@@ -276,7 +306,9 @@ std::vector<float> load_emission_hdf5(const std::string& path, const std::string
 
 std::vector<float> load_axial_plane_hdf5(const std::string& path, const std::string& dataset, int& nx, int& nr,
                                          const char* quantity) {
-  Hdf5Grid grid = read_hdf5_grid(path, dataset, 2);
+  GridNeeds needs;
+  needs.rank = 2;
+  Hdf5Grid grid = read_hdf5_grid(path, dataset, needs);
   const std::string what = path + ": dataset '" + dataset + "'";
   check_grid_values(what, grid.shape, grid.values, quantity);
   nx = grid.shape.nx;
@@ -372,9 +404,15 @@ DensityGrid load_density_fits(const std::string& path, double voxel_size_pc) {
     if (have_pix != 3 || have_val != 3)
       throw Error(what + ": give CRPIXi and CRVALi on all three axes, or none (origin 0)");
     const double v = grid.shape.voxel;
-    grid.shape.origin = Vec3{float(crval[0] + (0.5 - crpix[0]) * v),
-                             float(crval[1] + (0.5 - crpix[1]) * v),
-                             float(crval[2] + (0.5 - crpix[2]) * v)};
+    double origin[3];
+    for (int a = 0; a < 3; ++a) {
+      origin[a] = crval[a] + (0.5 - crpix[a]) * v;
+      if (!(std::fabs(origin[a]) <= 1e30))
+        throw Error(what + ": CRVAL" + std::to_string(a + 1) + " = " + to_text(crval[a]) + " and CRPIX" +
+                    std::to_string(a + 1) + " = " + to_text(crpix[a]) + " put the grid's corner at " +
+                    to_text(origin[a]) + " pc, beyond 1e30 pc (single precision)");
+    }
+    grid.shape.origin = Vec3{float(origin[0]), float(origin[1]), float(origin[2])};
   }
 
   try {

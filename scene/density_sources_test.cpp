@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include <sys/resource.h>
+
 #include "scene/test_files.h"
 
 namespace nebula {
@@ -447,6 +449,50 @@ TEST(Procedural, RefusesBadParameters) {
   refused([](ProceduralParams& p) { p.noise_octaves = 17; }, {"noise_octaves"});
   refused([](ProceduralParams& p) { p.noise_lacunarity = 1; }, {"noise_lacunarity"});
   EXPECT_FALSE(check_procedural(ProceduralParams{}).has_value());
+}
+
+// The peak resident memory of this process so far (bytes).
+size_t peak_resident_bytes() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return size_t(usage.ru_maxrss) * 1024;
+}
+
+// Issue 17, item 4: a small file claiming a 4 GiB grid is refused by the
+// cheap checks (no voxel_size; never written) before the values are
+// allocated: it allocated and zeroed the 4 GiB first.
+TEST_F(DensityFiles, CheapChecksComeBeforeTheAllocation) {
+  H5Dataset claim;
+  claim.dims = {1024, 1024, 1024};
+  write_h5(path("claim.h5"), {claim});
+  EXPECT_LT(testing::fs::file_size(path("claim.h5")), 100000u);
+  const size_t before = peak_resident_bytes();
+  expect_error([&] { load_density_hdf5(path("claim.h5")); }, {"claim.h5", "missing attribute 'voxel_size'"});
+  claim.voxel_size = 0.1;
+  write_h5(path("unwritten.h5"), {claim});
+  expect_error([&] { load_density_hdf5(path("unwritten.h5")); }, {"unwritten.h5", "never written"});
+  EXPECT_LT(peak_resident_bytes() - before, size_t(256) << 20) << "the loader allocated the claimed grid";
+}
+
+// Issue 17, item 4: a file cut short is refused before the allocation, naming
+// the file.
+TEST_F(DensityFiles, TruncatedFileIsRefused) {
+  H5Dataset set;
+  set.dims = {16, 16, 16};
+  set.values.assign(16 * 16 * 16, 0.5);
+  set.voxel_size = 0.1;
+  write_h5(path("cut.h5"), {set});
+  const auto size = testing::fs::file_size(path("cut.h5"));
+  testing::fs::resize_file(path("cut.h5"), size - 4000);
+  expect_error([&] { load_density_hdf5(path("cut.h5")); }, {"cut.h5"});
+}
+
+// Issue 17, a fuzz finding (scripts/fuzz.sh): a 2 KB density file whose
+// damaged metadata makes libhdf5 ask malloc for 2^51 bytes in H5C_protect.
+// Whatever libhdf5 does with it, the loader ends in one line naming the file.
+TEST_F(DensityFiles, FuzzFindingHugeMetadataAllocation) {
+  const std::string file = std::string(NEBULA_SCENES_DIR) + "/../fuzz/findings/density_hdf5_huge_metadata_alloc.h5";
+  expect_error([&] { load_density_hdf5(file); }, {"density_hdf5_huge_metadata_alloc.h5"});
 }
 
 }  // namespace

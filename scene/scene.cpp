@@ -66,6 +66,10 @@ std::optional<SceneIssue> star_issue(const SceneStar& star, const std::string& k
   if (!(std::isfinite(star.luminosity_lsun) && star.luminosity_lsun > 0))
     return SceneIssue{key + ".luminosity_lsun",
                       "is " + to_text(star.luminosity_lsun) + "; must be > 0 (L_sun)"};
+  if (star.luminosity_lsun > kMaxLuminosityLsun)
+    return SceneIssue{key + ".luminosity_lsun", "is " + to_text(star.luminosity_lsun) + "; must be at most " +
+                                                    to_text(kMaxLuminosityLsun) +
+                                                    " L_sun (a galaxy's; radiance is computed in single precision)"};
   if (!(std::isfinite(star.temperature_K) && star.temperature_K > 0))
     return SceneIssue{key + ".temperature_K",
                       "is " + to_text(star.temperature_K) + "; must be > 0 (K)"};

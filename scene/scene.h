@@ -31,6 +31,11 @@ struct DustParams {
   std::vector<std::string> table_files;
 };
 
+// The brightest star a scene may hold (L_sun): about a galaxy's light. Radiance
+// is single precision; this bound and the camera's exposure bound
+// (kMaxCameraExposure) keep every pixel finite.
+constexpr double kMaxLuminosityLsun = 1e12;
+
 struct SceneStar {
   std::string name;
   Vec3 position;           // parsecs, same frame as the grid
@@ -81,8 +86,15 @@ struct DiffuseSettings {
   uint64_t seed = 1;
 };
 
+// A file a scene reads: the key that names it ("scene" for the scene file
+// itself) and the path as resolved. Front ends refuse to write over any of them.
+struct SceneInput {
+  std::string key, path;
+};
+
 struct Scene {
   std::string path;  // the scene file as given ("demo" for demo_scene())
+  std::vector<SceneInput> inputs;  // every file the scene reads (load_scene fills it)
   std::vector<std::string> bands{"B", "V", "R"};
   DensityGrid density;  // tau_v per voxel (empty for an axial scene)
   std::optional<AxialSpec> axial;  // set instead of a density grid

@@ -12,6 +12,7 @@
 #include <initializer_list>
 #include <limits>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string_view>
 #include <utility>
@@ -113,6 +114,32 @@ class Parser {
       }
     }
     throw Error(one_line(message));
+  }
+
+  // A conflict between top-level tables: blames only an override that made
+  // one of `tables` (one the file itself lacks), never an unrelated one.
+  [[noreturn]] void fail_tables(const std::string& key, const std::string& reason,
+                                std::initializer_list<const char*> tables) const {
+    std::string message = name_ + ": " + key + ": " + reason;
+    bool blamed = false;
+    for (const char* table : tables) {
+      if (blamed || file_tables_.count(table) != 0) continue;
+      const std::string t(table);
+      for (auto it = overrides_.rbegin(); it != overrides_.rend() && !blamed; ++it)
+        if (it->first == t || it->first.rfind(t + ".", 0) == 0) {
+          message += " ([" + t + "] made by override '" + it->second + "')";
+          blamed = true;
+        }
+    }
+    throw Error(one_line(message));
+  }
+
+  // The top-level keys the file itself has, before any override.
+  void note_file_tables(const toml::table& root) {
+    for (auto&& [k, v] : root) {
+      (void)v;
+      file_tables_.insert(std::string(k.str()));
+    }
   }
 
   void apply_override(toml::table& root, const std::string& text);
@@ -238,6 +265,7 @@ class Parser {
   std::string name_;
   fs::path base_;
   std::vector<std::pair<std::string, std::string>> overrides_;  // key path, "KEY=VALUE"
+  std::set<std::string> file_tables_;
 };
 
 // ------------------------------------------------------------ overrides
@@ -715,7 +743,7 @@ Scene Parser::build(toml::table& root) {
   scene.bands = parse_bands(root);
   const bool axial = root.get("axial") != nullptr;
   if (axial && root.get("density") != nullptr)
-    fail("axial", "conflicts with [density]: a scene is either a 3D grid or an axial map");
+    fail_tables("axial", "conflicts with [density]: a scene is either a 3D grid or an axial map", {"axial", "density"});
   if (axial && root.get("emission") != nullptr)
     fail("emission", "applies to [density] grids; an axial map carries its own emission (axial.emission_prefix, "
                      "axial.emission_channels)");
@@ -747,6 +775,13 @@ Scene Parser::build(toml::table& root) {
   parse_output(root, scene);
   parse_render(root, scene);
   if (const auto issue = scene_detail::settings_issue(scene)) fail(issue->key, issue->reason);
+  // Every file the scene reads, so that no output is written over one of them.
+  if (!density.path.empty()) scene.inputs.push_back({density.key, density.path});
+  if (emission) scene.inputs.push_back({"emission.file", emission->path});
+  if (axial && !scene.axial->path.empty()) scene.inputs.push_back({"axial." + scene.axial->source, scene.axial->path});
+  for (size_t b = 0; b < scene.dust.table_files.size(); ++b)
+    if (!scene.dust.table_files[b].empty())
+      scene.inputs.push_back({"dust.tables." + scene.bands[b], scene.dust.table_files[b]});
   if (!axial) load_grids(density, emission, scene);  // the expensive part, last
   if (const auto issue = scene_detail::grids_issue(scene)) fail(issue->key, issue->reason);
   return scene;
@@ -764,6 +799,7 @@ Scene parse_scene(const std::string& text, const std::string& name, const fs::pa
                          std::string(e.description())));
   }
   Parser parser(name, base);
+  parser.note_file_tables(root);
   for (const std::string& o : overrides) parser.apply_override(root, o);
   return parser.build(root);
 }
@@ -786,7 +822,9 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw Error(path + ": cannot read the scene file");
-  return parse_scene(text.str(), path, fs::path(path).parent_path(), overrides);
+  Scene scene = parse_scene(text.str(), path, fs::path(path).parent_path(), overrides);
+  scene.inputs.insert(scene.inputs.begin(), SceneInput{"scene", path});
+  return scene;
 }
 
 ProceduralParams demo_procedural_params() { return ProceduralParams{}; }

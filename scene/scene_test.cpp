@@ -640,5 +640,54 @@ TEST_F(AxialSceneFile, RefusesBadKeys) {
   refused("override", kAxial, {"axial.step_texels", "override"}, {"axial.step_texels=-1"});
 }
 
+// Issue 17, item 7: a scene with both [axial] and [density] in the file names
+// no override, even when an unrelated axial key was overridden; an override
+// that made the conflicting table is named.
+TEST_F(AxialSceneFile, DensityConflictBlamesOnlyTheOverrideThatMadeIt) {
+  const std::string both = write_text("both.toml", std::string(kAxial) + "[density]\nprocedural = {}\n");
+  try {
+    load_scene(both, {"axial.step_texels=1"});
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("conflicts with [density]"), std::string::npos) << m;
+    EXPECT_EQ(m.find("override"), std::string::npos) << m;
+  }
+  refused("made", kAxial, {"axial", "conflicts with [density]", "density.scale=2"}, {"density.scale=2"});
+}
+
+// Issue 17, item 6: values whose consequences overflow single precision are
+// refused up front, naming the key (they rendered, then failed naming no key).
+TEST_F(SceneFile, RefusesValuesThatOverflowTheImage) {
+  refused("luminosity", edited("luminosity_lsun = 2e5", "luminosity_lsun = 1e300"),
+          {"stars.0.luminosity_lsun", "1e+300", "at most"});
+  refused("exposure", edited("look_at = [1.0, 1.0, 1.0]\n", "look_at = [1.0, 1.0, 1.0]\nexposure = 1e38\n"),
+          {"camera.exposure", "1e+38", "at most"});
+}
+
+// Issue 17, item 7: a camera far away is called far away, not "look_at equals
+// position".
+TEST_F(SceneFile, FarCameraIsCalledFar) {
+  const std::string far = edited("position = [1.0, -3.0, 1.0]", "position = [1e30, 1e30, 1e30]");
+  refused("far", far, {"camera.position", "farther than"});
+  const std::string text = write_text("far2.toml", far);
+  try {
+    load_scene(text);
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).find("equals the position"), std::string::npos) << e.what();
+  }
+}
+
+// Issue 17, item 7: a FITS origin beyond single precision names the file.
+TEST_F(SceneFile, FitsOriginOutOfRangeNamesTheFile) {
+  testing::FitsKeys keys;
+  keys.numbers = {{"CDELT1", 0.5}, {"CDELT2", 0.5}, {"CDELT3", 0.5}, {"CRPIX1", 1}, {"CRPIX2", 1}, {"CRPIX3", 1},
+                  {"CRVAL1", 1e308}, {"CRVAL2", 0}, {"CRVAL3", 0}};
+  write_fits(path("far.fits"), {2, 2, 2}, std::vector<double>(8, 0.1), -32, keys);
+  expect_error([&] { load_density_fits(path("far.fits")); }, {"far.fits", "CRVAL1"});
+  refused("fits", edited("procedural = { n = 16, size_pc = 2.0, seed = 3 }", "fits = \"far.fits\""),
+          {"density.fits", "far.fits", "CRVAL1"});
+}
+
 }  // namespace
 }  // namespace nebula

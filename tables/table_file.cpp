@@ -354,7 +354,9 @@ void write_table(const ScatteringTable& table, const std::string& path, bool ove
   temporary.publish();
 }
 
-ScatteringTable read_table(const std::string& path) {
+namespace {
+
+ScatteringTable read_table_here(const std::string& path) {
   ScatteringTable table;
   {
     const std::lock_guard<std::mutex> lock(hdf5io::hdf5_mutex());
@@ -382,6 +384,13 @@ ScatteringTable read_table(const std::string& path) {
   }
   table.check_consistency(path);
   return table;
+}
+
+}  // namespace
+
+ScatteringTable read_table(const std::string& path) {
+  hdf5io::read_in_child_first(path, [&] { read_table_here(path); });
+  return read_table_here(path);
 }
 
 }  // namespace nebula

@@ -1,0 +1,52 @@
+#include <string>
+
+#include "core/error.h"
+#include "core/memory.h"
+#include "pipeline/render_scene.h"
+
+namespace nebula {
+
+RunMemory estimate_run_memory(const Scene& scene, RunKind kind) {
+  RunMemory m;
+  const double bands = double(scene.bands.size());
+  const double pixels = double(scene.camera.width) * double(scene.camera.height);
+  // The image per band in float, and as much again for the writer's copy (the
+  // ground truth keeps a variance image too, and per-pixel accumulators).
+  const double image = pixels * bands * 4;
+  m.parts.push_back({"image " + std::to_string(scene.camera.width) + " x " + std::to_string(scene.camera.height) +
+                         " x " + to_text(bands) + " bands",
+                     kind == RunKind::Truth ? image * 5 : image * 2});
+  if (scene.axial) {
+    const AxialSpec& a = *scene.axial;
+    if (a.source == "synthetic")
+      m.parts.push_back({"axial map", double(a.nx) * double(a.nr) * (1 + bands) * 4 * 2});
+  } else {
+    const double voxels = double(scene.density.shape.count());
+    m.parts.push_back({"grids", voxels * 4 * (1 + double(scene.emission.size()))});
+    if (kind == RunKind::Fast) {
+      m.parts.push_back({"star bakes", voxels * 4 * double(scene.stars.size())});
+      if (scene.multiple_scattering == MultipleScattering::Pyramid)
+        m.parts.push_back({"pyramid levels", voxels * 4 * (1 + double(scene.stars.size())) / 7 + image / 3});
+      if (scene.multiple_scattering == MultipleScattering::Diffuse) {
+        const double cells = double(scene.diffuse.cells);
+        const double coefficients = double((scene.diffuse.order + 1) * (scene.diffuse.order + 1));
+        m.parts.push_back({"diffuse field", cells * cells * cells * coefficients * bands * 4 * 2});
+      }
+    } else {
+      m.parts.push_back({"majorant grid", voxels * 4});
+    }
+  }
+  for (const auto& part : m.parts) m.bytes += part.second;
+  return m;
+}
+
+void check_run_memory(const Scene& scene, RunKind kind) {
+  const RunMemory m = estimate_run_memory(scene, kind);
+  const std::string over = over_memory_limit(m.bytes);
+  if (over.empty()) return;
+  std::string parts;
+  for (const auto& [what, bytes] : m.parts) parts += (parts.empty() ? "" : ", ") + what + " " + bytes_text(bytes);
+  throw Error(scene.path + ": the run " + over + " (" + parts + "); lower camera.width/height or the grid's size");
+}
+
+}  // namespace nebula
