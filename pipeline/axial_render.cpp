@@ -25,6 +25,7 @@ RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
     throw ParameterError(scene.path + ": render.multiple_scattering",
                          "\"pyramid\" is for 3D grids; an axial map takes \"diffuse\" (the default) or \"none\"");
   validate_scene(scene);
+  check_run_memory(scene, RunKind::Fast);
   const AxialSpec& spec = *scene.axial;
   const AxialSkip skip = parse_axial_skip(spec.skip, scene.path + ": axial.skip");
   const Camera camera = make_camera(scene.camera);

@@ -16,10 +16,22 @@ RunMemory estimate_run_memory(const Scene& scene, RunKind kind) {
   m.parts.push_back({"image " + std::to_string(scene.camera.width) + " x " + std::to_string(scene.camera.height) +
                          " x " + to_text(bands) + " bands",
                      kind == RunKind::Truth ? image * 5 : image * 2});
+  const double cells = double(scene.diffuse.cells);
+  const double coefficients = double((scene.diffuse.order + 1) * (scene.diffuse.order + 1));
   if (scene.axial) {
     const AxialSpec& a = *scene.axial;
     if (a.source == "synthetic")
       m.parts.push_back({"axial map", double(a.nx) * double(a.nr) * (1 + bands) * 4 * 2});
+    if (kind == RunKind::Truth) {
+      // The map voxelized, at most 256^3 (the default --axial-voxels), with
+      // its emission planes and the majorant grid.
+      m.parts.push_back({"voxelized map", 256.0 * 256 * 256 * 4 * (2 + bands)});
+    } else if (scene.multiple_scattering == MultipleScattering::Diffuse && !scene.stars.empty()) {
+      // The photons' grid of 2 cells' worth of voxels per cell, its majorant,
+      // and the 3D field's sums (8 bytes) and harmonics.
+      const double grid = 8 * cells * cells * cells;
+      m.parts.push_back({"axial diffuse bake", grid * 4 * 2 + cells * cells * cells * coefficients * bands * 12});
+    }
   } else {
     const double voxels = double(scene.density.shape.count());
     m.parts.push_back({"grids", voxels * 4 * (1 + double(scene.emission.size()))});
@@ -28,9 +40,10 @@ RunMemory estimate_run_memory(const Scene& scene, RunKind kind) {
       if (scene.multiple_scattering == MultipleScattering::Pyramid)
         m.parts.push_back({"pyramid levels", voxels * 4 * (1 + double(scene.stars.size())) / 7 + image / 3});
       if (scene.multiple_scattering == MultipleScattering::Diffuse) {
-        const double cells = double(scene.diffuse.cells);
-        const double coefficients = double((scene.diffuse.order + 1) * (scene.diffuse.order + 1));
-        m.parts.push_back({"diffuse field", cells * cells * cells * coefficients * bands * 4 * 2});
+        // The field (kept, and packed for the kernels), its sums while baking
+        // (8 bytes each), and each view's light per voxel and band.
+        m.parts.push_back({"diffuse field", cells * cells * cells * coefficients * bands * (4 * 2 + 8)});
+        m.parts.push_back({"diffuse light per view", voxels * 4 * bands});
       }
     } else {
       m.parts.push_back({"majorant grid", voxels * 4});

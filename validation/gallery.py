@@ -20,6 +20,10 @@ voxels (`--set render.multiple_scattering=none`), with 1, 2 and 3 levels of the
 --study axial (Khalass 2021): scenes/axial_bipolar.toml, the thin bipolar
 map lit by a star at its waist, seen along the axis, at 60 degrees and
 across it, then the shells and the lopsided map at 60 degrees (no truth).
+--study axial_ms: validation/scenes/axial_lopsided_thick.toml (an axial map,
+optical depths up to about 5 from the star on its axis) without light
+scattered between texels and with the diffuse field (the default), beside
+one truth image (the map voxelized in its own frame), captioned with biases.
 Every image in a study, truth included, has the same exposure (the scene's
 camera.exposure) and the same tone mapping as `nebula render -o X.png`
 (value clamped to [0, 1], sRGB curve, 8 bits; red, green, blue from R, V, B),
@@ -27,7 +31,7 @@ so brightness and colour compare directly. Writes each image as HDF5 (the
 data, which compare reads) and PNG into --renders, and the montage into --out.
 --no-truth leaves the truth out (quick looks; the montage is the fast row).
 
-Usage: /usr/bin/python3 validation/gallery.py [--study fig12|pyramid|axial]
+Usage: /usr/bin/python3 validation/gallery.py [--study fig12|pyramid|axial|axial_ms]
            [--nebula build/bin/nebula] [--scene SCENE (default: the study's)]
            [--out docs/images] [--renders out/gallery] [--size 384]
            [--truth-spp 256 | --no-truth] [--backend auto]
@@ -76,6 +80,13 @@ STUDIES = {
         ("across", "bipolar, across the axis", ["--set", "camera.position=[6.0, 0.0, 0.0]"]),
         ("shells", "shells, 60 degrees", ["--set", 'axial.synthetic="shells"']),
         ("lopsided", "lopsided, 60 degrees", ["--set", 'axial.synthetic="lopsided"']),
+    ]),
+    "axial_ms": ("axial_diffuse.png",
+                 "An axial map with light scattered between texels: none, and the diffuse field (default); "
+                 "a = g = 0.6, optical depths up to about 5, same exposure",
+                 "validation/scenes/axial_lopsided_thick.toml", "shared", [
+        ("none", "no light scattered\nbetween texels", ["--set", "render.multiple_scattering=none"]),
+        ("diffuse", "diffuse field (default)", []),
     ]),
 }
 
