@@ -82,8 +82,8 @@ STUDIES = {
         ("lopsided", "lopsided, 60 degrees", ["--set", 'axial.synthetic="lopsided"']),
     ]),
     "axial_ms": ("axial_diffuse.png",
-                 "An axial map with light scattered between texels: none, and the diffuse field (default); "
-                 "a = g = 0.6, optical depths up to about 5, same exposure",
+                 "An axial map, a = g = 0.6, optical depths up to about 5 from the star:\n"
+                 "light scattered between texels left out, and the diffuse field (default); same exposure",
                  "validation/scenes/axial_lopsided_thick.toml", "shared", [
         ("none", "no light scattered\nbetween texels", ["--set", "render.multiple_scattering=none"]),
         ("diffuse", "diffuse field (default)", []),
