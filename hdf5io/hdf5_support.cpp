@@ -111,7 +111,9 @@ void read_in_child_first(const std::string& path, const std::function<void()>& r
   if (WIFSIGNALED(status))
     throw Error(path + ": the HDF5 library crashed reading it (" + strsignal(WTERMSIG(status)) +
                 "): the file is damaged or not what it claims to be");
-  throw Error(path + ": reading it failed in a child process (exit status " + std::to_string(WEXITSTATUS(status)) +
+  // Any other exit is a crash too: under a sanitizer (or a library that
+  // calls exit), a fault ends the child with a status instead of a signal.
+  throw Error(path + ": the HDF5 library crashed reading it (exit status " + std::to_string(WEXITSTATUS(status)) +
               "): the file is damaged or not what it claims to be");
 }
 
