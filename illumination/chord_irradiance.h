@@ -23,8 +23,6 @@ namespace nebula {
 struct ChordIrradiance {
   float inv_r2 = 0;  // mean of 1 / r^2 (softened) over the chord
   Vec3 point;        // where half of the chord's light has been received: theta is taken here
-  Vec3 point2;       // near the star: theta is taken here too and the two averaged (see below)
-  bool two = false;  // whether point2 is used
 };
 
 // The chord from origin + t0 dir to origin + t1 dir (unit dir) of a ray with
@@ -53,15 +51,8 @@ NEBULA_HD ChordIrradiance chord_irradiance(Vec3 origin, Vec3 dir, float t0, floa
   const float b = sqrtf(b2);
   const float a0 = atanf((t0 - tc) / b), a1 = atanf((t1 - tc) / b);
   out.inv_r2 = (a1 - a0) / (b * chord);
-  // Along the ray the light is uniform in the angle a = atan((t - tc) / b),
-  // and the scattering angle towards the eye is 90 degrees + a (the eye lies
-  // along -dir): the chord's light-weighted phase function is the mean of P
-  // over its angle interval. Two Gauss-Legendre points in a take it.
-  const float am = 0.5f * (a0 + a1), ah = 0.28867513f * (a1 - a0);  // half width / sqrt(3)
-  const float ta = tc + b * tanf(am - ah), tb = tc + b * tanf(am + ah);
-  out.point = origin + fminf(fmaxf(ta, t0), t1) * dir;
-  out.point2 = origin + fminf(fmaxf(tb, t0), t1) * dir;
-  out.two = true;
+  const float t = tc + b * tanf(0.5f * (a0 + a1));
+  out.point = origin + fminf(fmaxf(t, t0), t1) * dir;
   return out;
 }
 
@@ -69,10 +60,7 @@ NEBULA_HD ChordIrradiance chord_irradiance(Vec3 origin, Vec3 dir, float t0, floa
 // the footprint as above.
 NEBULA_HD ChordIrradiance point_irradiance(Vec3 point, Vec3 star, float width) {
   const Vec3 d = point - star;
-  ChordIrradiance out;
-  out.inv_r2 = 1.0f / fmaxf(dot(d, d) + width * width * kInv4Pi, 1e-30f);
-  out.point = point;
-  return out;
+  return {1.0f / fmaxf(dot(d, d) + width * width * kInv4Pi, 1e-30f), point};
 }
 
 }  // namespace nebula

@@ -70,14 +70,11 @@ NEBULA_HD void store_radiance(const RayResult& r, int n_bands, float exposure, f
 template <class Scene>
 NEBULA_HD void add_star_light(const Scene& s, Vec3 star, const float* power, float depth_v, const ChordIrradiance& at,
                               float tau_v, Vec3 to_eye, float* source, int* clamps) {
-  // theta: between the light's direction (star to dust) and the way to the eye.
   const Vec3 d = at.point - star;
   const float r = length(d);
+  // theta: between the light's direction (star to dust) and the way to the eye.
   const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
-  const Vec3 d2 = at.point2 - star;
-  const float r2 = length(d2);
-  const float mu2 = r2 > 0.0f ? dot(d2, to_eye) / r2 : 0.0f;
-  float u = TableView::kNoAngle, u2 = TableView::kNoAngle;  // bin coordinates, shared by bands with equal binning
+  float u = TableView::kNoAngle;  // the angle's bin coordinate, shared by bands with equal binning
   int u_from = -1;
   NEBULA_UNROLL
   for (int b = 0; b < kMaxBands; ++b) {
@@ -86,14 +83,11 @@ NEBULA_HD void add_star_light(const Scene& s, Vec3 star, const float* power, flo
     if (u_from < 0 || s.table[b].bins.kind != s.table[u_from].bins.kind ||
         s.table[b].bins.n != s.table[u_from].bins.n) {
       u = s.table[b].angle_coordinate(mu);
-      if (at.two) u2 = s.table[b].angle_coordinate(mu2);
       u_from = b;
     }
     const float tau_b = tau_v * s.extinction_ratio[b];
     const float e = power[b] * kInv4Pi * at.inv_r2 * expf(-depth_v * s.extinction_ratio[b]);
-    float p = s.table[b].lookup_at(s.albedo[b] * tau_b, u, clamps);
-    if (at.two) p = 0.5f * (p + s.table[b].lookup_at(s.albedo[b] * tau_b, u2, clamps));
-    source[b] += e * p;
+    source[b] += e * s.table[b].lookup_at(s.albedo[b] * tau_b, u, clamps);
   }
 }
 
