@@ -3,6 +3,9 @@
 # UBSan, and runs each for SECONDS (default 30) on a scratch copy of its seed
 # corpus (fuzz/corpus/<loader>). Findings land in build-fuzz/artifacts/; turn
 # each into a named test of its loader. Usage: scripts/fuzz.sh [SECONDS] [LOADER...]
+# NEBULA_FUZZ_CHILD=1 fuzzes the HDF5 loaders through the production path (a
+# child process reads each file first), which must turn every libhdf5 crash
+# into an error.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-30}
