@@ -96,6 +96,32 @@ std::vector<std::string> string_cards(const std::string& keyword, const std::str
   }
 }
 
+// A numeric entry's card: KEYWORD = VALUE / nebula key: KEY on one card (the
+// metadata rules keep numeric keys short enough). Reals are the shortest
+// decimal that reads back exactly, with a point or exponent so FITS reads
+// them as reals.
+std::string number_card(const std::string& keyword, const MetaValue& value, const std::string& comment) {
+  std::string text;
+  if (value.kind == MetaValue::Kind::Integer) {
+    text = std::to_string(value.integer);
+  } else {
+    text = exact_text(value.real);
+    for (char& c : text)
+      if (c == 'e') c = 'E';
+    if (text.find_first_of(".E") == std::string::npos) text += ".0";
+  }
+  std::string card;
+  if (keyword.size() <= 8) {
+    card = keyword + std::string(8 - keyword.size(), ' ') + "= ";
+    if (text.size() < 20) card += std::string(20 - text.size(), ' ');  // fixed format: right-justified to column 30
+  } else {
+    card = "HIERARCH " + keyword + " = ";
+  }
+  card += text + " / " + comment;
+  if (card.size() > 80) throw Error("keyword " + keyword + ": value and key do not fit one card");
+  return card;
+}
+
 // Reads one open file; every failure names the file and the keyword.
 class Reader {
  public:
@@ -149,11 +175,11 @@ class Reader {
 
   // The metadata entries, in header order: string keywords whose comment
   // carries the marker and the key, which must match the keyword.
-  std::vector<std::pair<std::string, std::string>> entries() const {
+  MetaEntries entries() const {
     int count = 0, status = 0;
     if (fits_get_hdrspace(f_, &count, nullptr, &status) != 0)
       fail(path_, "header", "a readable header", cfitsio_reason(status));
-    std::vector<std::pair<std::string, std::string>> found;
+    MetaEntries found;
     for (int i = 1; i <= count; ++i) {
       char card[FLEN_CARD] = {0}, name[FLEN_KEYWORD] = {0};
       int length = 0;
@@ -162,9 +188,28 @@ class Reader {
         fail(path_, "header card " + std::to_string(i), "a readable card", cfitsio_reason(status));
       const std::string keyword = name;
       if (keyword.empty() || keyword == "COMMENT" || keyword == "HISTORY" || keyword == "CONTINUE") continue;
-      if (type_of(keyword) != 'C') continue;
+      const char type = type_of(keyword);
       std::string comment;
-      const std::string value = string_key(keyword, "a string", &comment);
+      MetaValue value;
+      if (type == 'C') {
+        value = string_key(keyword, "a string", &comment);
+      } else if (type == 'I' || type == 'F') {
+        char text[FLEN_VALUE] = {0}, note[FLEN_COMMENT] = {0};
+        if (fits_parse_value(card, text, note, &status) != 0)
+          fail(path_, keyword, "a readable number", cfitsio_reason(status));
+        comment = trim(note);
+        if (comment.rfind(kEntryMarker, 0) != 0) continue;
+        if (type == 'I') {
+          LONGLONG n = 0;
+          if (fits_read_key_lnglng(f_, keyword.c_str(), &n, nullptr, &status) != 0)
+            fail(path_, keyword, "an integer of 64 bits", cfitsio_reason(status));
+          value = static_cast<long long>(n);
+        } else {
+          value = double_key(keyword, "a number");
+        }
+      } else {
+        continue;
+      }
       if (comment.rfind(kEntryMarker, 0) != 0) continue;
       const std::string key = comment.substr(kEntryMarker.size());
       if (upper(key) != keyword)
@@ -214,7 +259,13 @@ void write_fits(const Image& image, const ImageMetadata& metadata, const std::st
   if (fits_write_key_dbl(fits.f, "EXPOSURE", metadata.exposure, -17,
                          "display scale before tone mapping (not a time)", &status) != 0)
     throw Error("writing keyword EXPOSURE (" + cfitsio_reason(status) + ")");
-  for (const auto& [key, value] : metadata.entries) write_string(upper(key), value, kEntryMarker + key);
+  for (const auto& [key, value] : metadata.entries) {
+    if (!value.is_number()) {
+      write_string(upper(key), value.text, kEntryMarker + key);
+    } else if (fits_write_record(fits.f, number_card(upper(key), value, kEntryMarker + key).c_str(), &status) != 0) {
+      throw Error("writing keyword " + upper(key) + " (" + cfitsio_reason(status) + ")");
+    }
+  }
   if (continued && fits_write_key_longwarn(fits.f, &status) != 0)
     throw Error("writing keyword LONGSTRN (" + cfitsio_reason(status) + ")");
 
@@ -232,6 +283,18 @@ void write_fits(const Image& image, const ImageMetadata& metadata, const std::st
   }
   if (fits_write_chksum(fits.f, &status) != 0)
     throw Error("writing the checksums (" + cfitsio_reason(status) + ")");
+
+  // The resolved scene: its bytes in a 1-D 8-bit image extension SCENE
+  // (astropy: bytes(hdul["SCENE"].data).decode()).
+  if (!metadata.scene_text.empty()) {
+    long length[1] = {static_cast<long>(metadata.scene_text.size())};
+    if (fits_create_img(fits.f, BYTE_IMG, 1, length, &status) != 0 ||
+        fits_write_key_str(fits.f, "EXTNAME", "SCENE", "the resolved scene (TOML text, UTF-8 bytes)", &status) != 0 ||
+        fits_write_img(fits.f, TBYTE, 1, static_cast<LONGLONG>(metadata.scene_text.size()),
+                       const_cast<char*>(metadata.scene_text.data()), &status) != 0 ||
+        fits_write_chksum(fits.f, &status) != 0)
+      throw Error("writing the SCENE extension (" + cfitsio_reason(status) + ")");
+  }
   fitsfile* f = fits.f;
   fits.f = nullptr;
   if (fits_close_file(f, &status) != 0) throw Error("writing the FITS file (" + cfitsio_reason(status) + ")");
@@ -291,6 +354,40 @@ Image read_fits(const std::string& path, ImageMetadata* metadata) {
   if (!std::isfinite(m.exposure) || m.exposure <= 0)
     fail(path, "EXPOSURE", "a finite positive number", exact_text(m.exposure));
   m.entries = r.entries();
+
+  // The scene text, when the file has the extension. A second HDU must pass
+  // its checksums whatever it is; a foreign one is otherwise left alone.
+  int hdus = 0;
+  if (fits_get_num_hdus(fits.f, &hdus, &status) != 0) fail(path, "HDUs", "a readable file", cfitsio_reason(status));
+  if (hdus < 2 && !ec && size_t(data_end) < file_size)
+    fail(path, "HDU 2", "a readable extension after the primary HDU", "bytes that are none (damaged file?)");
+  if (hdus >= 2) {
+    int hdu_type = 0;
+    if (fits_movabs_hdu(fits.f, 2, &hdu_type, &status) != 0)
+      fail(path, "HDU 2", "a readable extension", cfitsio_reason(status));
+    int data_ok = 0, header_ok = 0;
+    if (fits_verify_chksum(fits.f, &data_ok, &header_ok, &status) != 0 || data_ok < 0 || header_ok < 0)
+      fail(path, "HDU 2 CHECKSUM", "an extension with matching checksums", "a mismatch (damaged file?)");
+    char extname[FLEN_VALUE] = {0};
+    if (fits_read_key_str(fits.f, "EXTNAME", extname, nullptr, &status) != 0) {
+      status = 0;
+      fits_clear_errmsg();
+    }
+    if (std::string(extname) == "SCENE") {
+      long length[1] = {0};
+      int dims = 0, bits = 0;
+      if (fits_get_img_param(fits.f, 1, &bits, &dims, length, &status) != 0 || bits != BYTE_IMG || dims != 1 ||
+          length[0] <= 0 || size_t(length[0]) > kMaxElements)
+        fail(path, "SCENE", "a 1-D 8-bit extension holding the scene text", "another shape");
+      std::string text(size_t(length[0]), '\0');
+      int any_null = 0;
+      unsigned char no_null = 0;
+      if (fits_read_img(fits.f, TBYTE, 1, length[0], &no_null, &text[0], &any_null, &status) != 0)
+        fail(path, "SCENE", "readable scene text", cfitsio_reason(status));
+      m.scene_text = text;
+    }
+    if (fits_movabs_hdu(fits.f, 1, nullptr, &status) != 0) fail(path, "primary HDU", "readable", cfitsio_reason(status));
+  }
 
   image.pixels.resize(count);
   const size_t width = image.width, plane = image.plane_size();

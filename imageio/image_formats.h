@@ -34,7 +34,10 @@ inline const char* const kBandsName = "bands";
 inline const char* const kUnitsName = "units";
 inline const char* const kExposureName = "exposure";
 inline const char* const kSchemaName = "schema_version";
-constexpr int kSchemaVersion = 1;
+inline const char* const kSceneName = "scene_toml";
+// 2: typed entries (numbers as numbers), HDF5 band names as a string array,
+// EXR channels R, G, B for the bands R, V, B. Readers take 1 and 2.
+constexpr int kSchemaVersion = 2;
 
 // "PATH: FIELD: expected EXPECTED, found FOUND", the form of every read error.
 [[noreturn]] void fail(const std::string& path, const std::string& field,

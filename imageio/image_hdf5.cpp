@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cstring>
 #include <cmath>
 #include <filesystem>
 #include <mutex>
@@ -35,6 +36,23 @@ void write_string(hid_t object, const std::string& name, const std::string& valu
   Handle attr(H5Acreate2(object, name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT),
               H5Aclose);
   if (!attr.valid() || H5Awrite(attr.get(), type.get(), value.c_str()) < 0)
+    throw Error(with_reason("writing attribute " + name));
+}
+
+// The band names as a 1-D array of fixed-length strings (h5py: a list).
+void write_string_array(hid_t object, const std::string& name, const std::vector<std::string>& values) {
+  size_t longest = 1;
+  for (const std::string& v : values) longest = std::max(longest, v.size() + 1);
+  std::vector<char> buffer(values.size() * longest, '\0');
+  for (size_t i = 0; i < values.size(); ++i) std::copy(values[i].begin(), values[i].end(), &buffer[i * longest]);
+  Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
+  const hsize_t n = values.size();
+  Handle space(H5Screate_simple(1, &n, nullptr), H5Sclose);
+  if (!type.valid() || !space.valid() || H5Tset_size(type.get(), longest) < 0 ||
+      H5Tset_strpad(type.get(), H5T_STR_NULLTERM) < 0)
+    throw Error(with_reason("making the string array attribute " + name));
+  Handle attr(H5Acreate2(object, name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  if (!attr.valid() || H5Awrite(attr.get(), type.get(), buffer.data()) < 0)
     throw Error(with_reason("writing attribute " + name));
 }
 
@@ -110,6 +128,42 @@ class Reader {
     if (H5Tget_strpad(file_type.get()) == H5T_STR_SPACEPAD)
       while (!value.empty() && value.back() == ' ') value.pop_back();
     return value;
+  }
+
+  // Band names: a 1-D array of fixed-length strings (schema 2).
+  std::vector<std::string> string_array(const std::string& name, size_t count) const {
+    const std::string expected = std::to_string(count) + " band names (the first dimension of /image)";
+    const htri_t exists = H5Aexists(file_, name.c_str());
+    if (exists <= 0) fail(path_, name, expected, "no such attribute (not a nebula image?)");
+    Handle attr(H5Aopen(file_, name.c_str(), H5P_DEFAULT), H5Aclose);
+    Handle type(attr.valid() ? H5Aget_type(attr.get()) : -1, H5Tclose);
+    Handle space(attr.valid() ? H5Aget_space(attr.get()) : -1, H5Sclose);
+    if (!type.valid() || !space.valid() || H5Tget_class(type.get()) != H5T_STRING ||
+        H5Tis_variable_str(type.get()) != 0)
+      fail(path_, name, expected, "not an array of fixed-length strings");
+    const hssize_t points = H5Sget_simple_extent_npoints(space.get());
+    if (points < 0 || size_t(points) != count) fail(path_, name, expected, std::to_string(points) + " strings");
+    const size_t size = H5Tget_size(type.get());
+    if (size == 0 || size > 4096) fail(path_, name, expected, "strings of " + std::to_string(size) + " bytes");
+    std::vector<char> buffer(size * count + 1, '\0');
+    Handle memory_type(H5Tcopy(type.get()), H5Tclose);
+    if (!memory_type.valid() || H5Aread(attr.get(), memory_type.get(), buffer.data()) < 0)
+      fail(path_, name, expected, with_reason("a read error"));
+    std::vector<std::string> out;
+    for (size_t i = 0; i < count; ++i) out.emplace_back(&buffer[i * size], strnlen(&buffer[i * size], size));
+    return out;
+  }
+
+  // A metadata entry: an integer, float or string attribute.
+  MetaValue entry(const std::string& name) const {
+    Handle attr(H5Aopen(file_, name.c_str(), H5P_DEFAULT), H5Aclose);
+    Handle type(attr.valid() ? H5Aget_type(attr.get()) : -1, H5Tclose);
+    const H5T_class_t cls = type.valid() ? H5Tget_class(type.get()) : H5T_NO_CLASS;
+    if (cls == H5T_INTEGER) return MetaValue(integer_attribute(name));
+    if (cls == H5T_FLOAT) return MetaValue(double_attribute(name));
+    if (cls == H5T_STRING) return MetaValue(string_attribute(name));
+    fail(path_, name, "an integer, float or string attribute (a metadata entry)",
+         std::string("an attribute of class ") + class_name(cls));
   }
 
   double double_attribute(const std::string& name) const {
@@ -189,10 +243,18 @@ void write_hdf5(const Image& image, const ImageMetadata& metadata, const std::st
 
   const int schema = kSchemaVersion;
   write_scalar(f, kSchemaName, H5T_STD_I32LE, H5T_NATIVE_INT, &schema);
-  write_string(f, kBandsName, join_bands(image.bands));
+  write_string_array(f, kBandsName, image.bands);
   write_string(f, kUnitsName, metadata.units);
   write_scalar(f, kExposureName, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &metadata.exposure);
-  for (const auto& [key, value] : metadata.entries) write_string(f, key, value);
+  for (const auto& [key, value] : metadata.entries) {
+    if (value.kind == MetaValue::Kind::Integer)
+      write_scalar(f, key.c_str(), H5T_STD_I64LE, H5T_NATIVE_LLONG, &value.integer);
+    else if (value.kind == MetaValue::Kind::Real)
+      write_scalar(f, key.c_str(), H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value.real);
+    else
+      write_string(f, key, value.text);
+  }
+  if (!metadata.scene_text.empty()) write_string(f, kSceneName, metadata.scene_text);
 
   if (!file.close()) throw Error(with_reason("writing the HDF5 file"));
 }
@@ -210,8 +272,8 @@ Image read_hdf5(const std::string& path, ImageMetadata* metadata) {
 
   // The schema first: a newer layout would otherwise fail confusingly.
   const long long schema = r.integer_attribute(kSchemaName);
-  if (schema != kSchemaVersion)
-    fail(path, kSchemaName, "1 (the only image schema this reader knows)", std::to_string(schema));
+  if (schema != 1 && schema != kSchemaVersion)
+    fail(path, kSchemaName, "1 or 2 (the image schemas this reader knows)", std::to_string(schema));
 
   const std::string expected = "a 3-D float dataset [bands][height][width]";
   const htri_t exists = H5Lexists(f, "/image", H5P_DEFAULT);
@@ -249,11 +311,18 @@ Image read_hdf5(const std::string& path, ImageMetadata* metadata) {
   if (H5Dread(set.get(), H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, image.pixels.data()) < 0)
     fail(path, "/image", "a readable dataset", with_reason("an HDF5 read error"));
 
-  const std::string bands = r.string_attribute(kBandsName);
-  image.bands = split_bands(bands);
-  if (image.bands.size() != dims[0])
-    fail(path, kBandsName, std::to_string(dims[0]) + " comma-separated band names (the first dimension of /image)",
-         "'" + bands + "'");
+  Handle bands_attr(H5Aexists(f, kBandsName) > 0 ? H5Aopen(f, kBandsName, H5P_DEFAULT) : -1, H5Aclose);
+  Handle bands_space(bands_attr.valid() ? H5Aget_space(bands_attr.get()) : -1, H5Sclose);
+  const bool scalar_bands = bands_space.valid() && H5Sget_simple_extent_type(bands_space.get()) == H5S_SCALAR;
+  if (schema == 1 || scalar_bands) {  // the band names comma-separated in one string (schema 1)
+    const std::string bands = r.string_attribute(kBandsName);
+    image.bands = split_bands(bands);
+    if (image.bands.size() != dims[0])
+      fail(path, kBandsName, std::to_string(dims[0]) + " comma-separated band names (the first dimension of /image)",
+           "'" + bands + "'");
+  } else {
+    image.bands = r.string_array(kBandsName, dims[0]);
+  }
 
   ImageMetadata m;
   m.units = r.string_attribute(kUnitsName);
@@ -262,7 +331,11 @@ Image read_hdf5(const std::string& path, ImageMetadata* metadata) {
     fail(path, kExposureName, "a finite positive number", exact_text(m.exposure));
   for (const std::string& name : attribute_names(path, f)) {
     if (name == kSchemaName || name == kBandsName || name == kUnitsName || name == kExposureName) continue;
-    m.entries.emplace_back(name, r.string_attribute(name));
+    if (name == kSceneName) {
+      m.scene_text = r.string_attribute(name);
+      continue;
+    }
+    m.entries.emplace_back(name, schema == 1 ? MetaValue(r.string_attribute(name)) : r.entry(name));
   }
   *metadata = m;
   return image;

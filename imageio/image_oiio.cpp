@@ -57,6 +57,23 @@ namespace {
 const std::string kPrefix = "nebula:";
 const std::string kEntryPrefix = "nebula:entry:";
 const std::string kEntryOrder = "nebula:entry_order";
+const std::string kChannels = "nebula:channels";
+
+// The EXR channel of each band: with bands R, V and B present, those three
+// are the channels R, G and B (viewers show colour); every other band is a
+// one-channel layer "<band>.Y".
+std::vector<std::string> exr_channels(const std::vector<std::string>& bands) {
+  auto has = [&](const char* b) { return std::find(bands.begin(), bands.end(), b) != bands.end(); };
+  const bool colour = has("R") && has("V") && has("B");
+  std::vector<std::string> channels;
+  for (const std::string& band : bands) {
+    if (colour && band == "R") channels.push_back("R");
+    else if (colour && band == "V") channels.push_back("G");
+    else if (colour && band == "B") channels.push_back("B");
+    else channels.push_back(band + ".Y");
+  }
+  return channels;
+}
 
 // OpenImageIO's messages may span lines; ours are one line.
 std::string one_line(std::string text) {
@@ -72,10 +89,20 @@ void add_metadata(OIIO::ImageSpec& spec, const ImageMetadata& m) {
   spec.attribute(kPrefix + kExposureName, exact_text(m.exposure));
   std::vector<std::string> keys;
   for (const auto& [key, value] : m.entries) {
-    spec.attribute(kEntryPrefix + key, value);
+    // OpenEXR has int (32-bit), double and string attributes; a larger
+    // integer travels as a double.
+    if (value.kind == MetaValue::Kind::Integer && value.integer == static_cast<int>(value.integer))
+      spec.attribute(kEntryPrefix + key, static_cast<int>(value.integer));
+    else if (value.is_number()) {
+      const double number = value.number();
+      spec.attribute(kEntryPrefix + key, OIIO::TypeDesc::DOUBLE, &number);
+    }
+    else
+      spec.attribute(kEntryPrefix + key, value.text);
     keys.push_back(key);
   }
   spec.attribute(kEntryOrder, join_bands(keys));
+  if (!m.scene_text.empty()) spec.attribute(kPrefix + "scene", m.scene_text);
 }
 
 void write_with(const char* format, const OIIO::ImageSpec& spec, OIIO::TypeDesc type,
@@ -93,9 +120,10 @@ void write_with(const char* format, const OIIO::ImageSpec& spec, OIIO::TypeDesc 
 void write_exr(const Image& image, const ImageMetadata& metadata, const std::string& file_name) {
   const int channels = static_cast<int>(image.bands.size());
   OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::FLOAT);
-  spec.channelnames = image.bands;
+  spec.channelnames = exr_channels(image.bands);
   spec.attribute("compression", "zip");
   spec.attribute(kPrefix + kBandsName, join_bands(image.bands));
+  spec.attribute(kChannels, join_bands(spec.channelnames));
   add_metadata(spec, metadata);
   // OpenImageIO takes pixels interleaved; ours are planes.
   const size_t plane = image.plane_size();
@@ -147,12 +175,17 @@ Image read_exr(const std::string& path, ImageMetadata* metadata) {
   if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, interleaved.data()))
     fail(path, "pixels", "readable pixels", "OpenImageIO: " + one_line(in->geterror()));
 
-  // Our band order, whatever order the file keeps its channels in.
-  std::vector<std::string> bands = spec.channelnames;
+  // Our band order, whatever order the file keeps its channels in; the
+  // channel of each band (schema 2: R, G, B for the bands R, V, B).
+  std::vector<std::string> bands = spec.channelnames, channels = spec.channelnames;
   const std::string stored = spec.get_string_attribute(kPrefix + kBandsName);
   if (!stored.empty()) {
     bands = split_bands(stored);
-    std::vector<std::string> a = bands, b = spec.channelnames;
+    const std::string stored_channels = spec.get_string_attribute(kChannels);
+    channels = stored_channels.empty() ? bands : split_bands(stored_channels);
+    if (channels.size() != bands.size())
+      fail(path, kChannels, "one channel per band of " + stored, "'" + stored_channels + "'");
+    std::vector<std::string> a = channels, b = spec.channelnames;
     std::sort(a.begin(), a.end());
     std::sort(b.begin(), b.end());
     if (a != b)
@@ -165,7 +198,7 @@ Image read_exr(const std::string& path, ImageMetadata* metadata) {
   image.bands = bands;
   image.pixels.resize(plane * bands.size());
   for (size_t b = 0; b < bands.size(); ++b) {
-    const size_t c = std::find(spec.channelnames.begin(), spec.channelnames.end(), bands[b]) -
+    const size_t c = std::find(spec.channelnames.begin(), spec.channelnames.end(), channels[b]) -
                      spec.channelnames.begin();
     for (size_t i = 0; i < plane; ++i) image.pixels[b * plane + i] = interleaved[i * spec.nchannels + c];
   }
@@ -173,8 +206,8 @@ Image read_exr(const std::string& path, ImageMetadata* metadata) {
   // Any EXR is accepted; what it lacks keeps ImageMetadata's defaults. One
   // of ours from a newer layout is refused.
   const int schema = spec.get_int_attribute(kPrefix + kSchemaName, kSchemaVersion);
-  if (schema != kSchemaVersion)
-    fail(path, kPrefix + kSchemaName, "1 (the only image schema this reader knows)", std::to_string(schema));
+  if (schema != 1 && schema != kSchemaVersion)
+    fail(path, kPrefix + kSchemaName, "1 or 2 (the image schemas this reader knows)", std::to_string(schema));
   ImageMetadata m;
   m.units = spec.get_string_attribute(kPrefix + kUnitsName, m.units);
   const std::string exposure = spec.get_string_attribute(kPrefix + kExposureName);
@@ -186,10 +219,18 @@ Image read_exr(const std::string& path, ImageMetadata* metadata) {
       // OpenImageIO writes no attribute for an empty string: a listed entry
       // without one is empty.
       const OIIO::ParamValue* p = spec.find_attribute(kEntryPrefix + key);
-      if (p != nullptr && p->type() != OIIO::TypeDesc::STRING)
-        fail(path, kEntryPrefix + key, "a string attribute", "an attribute of type " + std::string(p->type().c_str()));
-      m.entries.emplace_back(key, p != nullptr ? p->get_string() : std::string());
+      if (p == nullptr || p->type() == OIIO::TypeDesc::STRING)
+        m.entries.emplace_back(key, p != nullptr ? p->get_string() : std::string());
+      else if (p->type() == OIIO::TypeDesc::INT)
+        m.entries.emplace_back(key, p->get_int());
+      else if (p->type() == OIIO::TypeDesc::DOUBLE || p->type() == OIIO::TypeDesc::FLOAT)
+        m.entries.emplace_back(key, p->type() == OIIO::TypeDesc::DOUBLE ? *static_cast<const double*>(p->data())
+                                                                      : double(p->get_float()));
+      else
+        fail(path, kEntryPrefix + key, "a string, int or double attribute",
+             "an attribute of type " + std::string(p->type().c_str()));
     }
+  m.scene_text = spec.get_string_attribute(kPrefix + "scene");
   *metadata = m;
   return image;
 }

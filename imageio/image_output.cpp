@@ -56,6 +56,12 @@ bool parse_double(const std::string& text, double& value) {
 
 }  // namespace imageio_detail
 
+std::string MetaValue::to_text() const {
+  if (kind == Kind::Text) return text;
+  if (kind == Kind::Integer) return std::to_string(integer);
+  return imageio_detail::exact_text(real);
+}
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -113,7 +119,7 @@ bool reserved_key(const std::string& key) {
       "BANDS",    "UNITS",    "EXPOSURE", "SCHEMA_VERSION", "SIMPLE",  "BITPIX",  "NAXIS",
       "EXTEND",   "BSCALE",   "BZERO",    "BLANK",          "BUNIT",   "END",     "COMMENT",
       "HISTORY",  "CONTINUE", "LONGSTRN", "HIERARCH",       "XTENSION", "PCOUNT", "GCOUNT",
-      "GROUPS",   "CHECKSUM", "DATASUM",  "DATAMIN",        "DATAMAX"};
+      "GROUPS",   "CHECKSUM", "DATASUM",  "DATAMIN",        "DATAMAX", "SCENE_TOML", "EXTNAME"};
   static const std::regex numbered("(NAXIS|BAND)[0-9]+");
   return names.count(upper) > 0 || std::regex_match(upper, numbered);
 }
@@ -180,6 +186,8 @@ void check_metadata(const ImageMetadata& m, const std::string& path) {
   const std::string where = "cannot write " + path + ": ";
   if (!std::isfinite(m.exposure) || m.exposure <= 0)
     throw Error(where + "exposure " + exact_text(m.exposure) + " must be finite and positive");
+  if (m.scene_text.find('\0') != std::string::npos)
+    throw Error(where + "the scene text holds a NUL byte");
   if (m.units.empty() || !printable_ascii(m.units) || trailing_blank(m.units))
     throw Error(where + "units " + quoted(m.units) +
                 " must be non-empty printable ASCII without trailing blanks");
@@ -195,9 +203,16 @@ void check_metadata(const ImageMetadata& m, const std::string& path) {
                    [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
     if (!seen.insert(upper).second)
       throw Error(where + "metadata key '" + key + "' appears twice (keys are compared ignoring case)");
-    if (!printable_ascii(value) || trailing_blank(value))
-      throw Error(where + "metadata " + key + " = " + quoted(value) +
+    if (value.is_number()) {
+      // KEY = VALUE / nebula key: KEY on one FITS card: 51 + 2 x 14 <= 80.
+      if (key.size() > 14)
+        throw Error(where + "metadata key '" + key + "' holds a number: numeric keys have at most 14 characters");
+      if (!std::isfinite(value.number()))
+        throw Error(where + "metadata " + key + " = " + value.to_text() + " must be a finite number");
+    } else if (!printable_ascii(value.text) || trailing_blank(value.text)) {
+      throw Error(where + "metadata " + key + " = " + quoted(value.text) +
                   " must be printable ASCII without trailing blanks");
+    }
   }
 }
 

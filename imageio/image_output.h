@@ -3,6 +3,7 @@
 // band to HDF5, FITS and EXR, tone-mapped sRGB to PNG. Layouts, orientation
 // and the tone curve are in docs/image_files.md.
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -10,17 +11,56 @@
 
 namespace nebula {
 
+// A metadata value: text, an integer or a real number. Numbers travel as
+// numbers (FITS numeric keywords, HDF5 int64/float64 attributes, EXR int and
+// double attributes) so that astropy, h5py and the like read them as such.
+struct MetaValue {
+  enum class Kind { Text, Integer, Real };
+  Kind kind = Kind::Text;
+  std::string text;
+  long long integer = 0;
+  double real = 0;
+
+  MetaValue() = default;
+  MetaValue(std::string value) : text(std::move(value)) {}
+  MetaValue(const char* value) : text(value) {}
+  MetaValue(double value) : kind(Kind::Real), real(value) {}
+  MetaValue(float value) : MetaValue(double(value)) {}
+  template <class I, std::enable_if_t<std::is_integral_v<I> && !std::is_same_v<I, bool>, int> = 0>
+  MetaValue(I value) : kind(Kind::Integer), integer(static_cast<long long>(value)) {}
+  MetaValue(bool) = delete;  // say what a flag means: an integer 0/1 or a word
+
+  bool is_number() const { return kind != Kind::Text; }
+  double number() const { return kind == Kind::Integer ? double(integer) : real; }
+  // The value as text: the text itself, or the shortest exact decimal.
+  std::string to_text() const;
+  bool operator==(const MetaValue& o) const {
+    return kind == o.kind && (kind == Kind::Text ? text == o.text
+                              : kind == Kind::Integer ? integer == o.integer
+                                                      : (real == o.real || (real != real && o.real != o.real)));
+  }
+  bool operator!=(const MetaValue& o) const { return !(*this == o); }
+};
+using MetaEntries = std::vector<std::pair<std::string, MetaValue>>;
+
 // What a file says besides its pixels. Keys are 1 to 24 characters of
 // [A-Za-z0-9_-] starting with a letter, unique ignoring case (FITS keywords
 // are upper case) and not one of the names the layouts use themselves;
-// values are printable ASCII without trailing blanks (FITS headers are ASCII
-// and drop trailing blanks), units the same and not empty. Within these
-// rules every format gives back exactly what was written.
+// text values are printable ASCII without trailing blanks (FITS headers are
+// ASCII and drop trailing blanks), numbers finite; units the same as text
+// and not empty. Within these rules every format gives back exactly what was
+// written, numbers as numbers of the same kind.
 struct ImageMetadata {
   std::string units = "arbitrary";
-  std::vector<std::pair<std::string, std::string>> entries;  // e.g. {"albedo_B", "0.6"}
-  double exposure = 1.0;  // PNG: scale applied before tone mapping; stored as a hint elsewhere
+  MetaEntries entries;  // e.g. {"albedo_B", 0.6}, {"camera_kind", "perspective"}
+  // PNG: scale applied before tone mapping. The science formats record it
+  // and leave the pixels alone: a display setting, not part of the data.
+  double exposure = 1.0;
   double gamma = 2.2;     // unused by the writers: PNG uses the sRGB curve (README)
+  // The resolved scene (TOML text) the image was made from, or empty. Any
+  // bytes but NUL; FITS keeps it in an extension SCENE, HDF5 in the
+  // attribute scene_toml, EXR in nebula:scene.
+  std::string scene_text;
 };
 
 // Writes IMAGE to PATH in the format its extension names: .h5, .fits or

@@ -68,7 +68,14 @@ ImageMetadata make_metadata() {
       {"Mixed-Case_key", "  leading blanks are kept"},
       {"empty", ""},
       {"ends_in_mark", "value&"},
+      {"int_key", 42},
+      {"NEG_INT", -1234567890},
+      {"real_key", 0.1},
+      {"tiny_real", 2.2250738585072014e-308},
+      {"whole_real", 3.0},
+      {"CRPIX1", -1.5e300},
   };
+  m.scene_text = "[camera]\nkind = \"perspective\"  # a comment, 'quotes', \u00e9\n\ttab\n";
   return m;
 }
 
@@ -84,7 +91,15 @@ void expect_same_bits(const Image& a, const Image& b) {
 void expect_same_metadata(const ImageMetadata& a, const ImageMetadata& b) {
   EXPECT_EQ(a.units, b.units);
   EXPECT_EQ(a.exposure, b.exposure);
-  EXPECT_EQ(a.entries, b.entries);
+  ASSERT_EQ(a.entries.size(), b.entries.size());
+  for (size_t i = 0; i < a.entries.size(); ++i) {
+    EXPECT_EQ(a.entries[i].first, b.entries[i].first);
+    EXPECT_TRUE(a.entries[i].second == b.entries[i].second)
+        << a.entries[i].first << ": wrote " << a.entries[i].second.to_text() << " (kind "
+        << int(a.entries[i].second.kind) << "), read " << b.entries[i].second.to_text() << " (kind "
+        << int(b.entries[i].second.kind) << ")";
+  }
+  EXPECT_EQ(a.scene_text, b.scene_text);
 }
 
 std::string file_bytes(const std::string& path) {
@@ -133,9 +148,31 @@ TEST_F(ImageFile, Hdf5LayoutAsDocumented) {
   EXPECT_EQ(raw[7], image.at(0, 0, 1));  // second row
   const hid_t bands = H5Aopen(file, "bands", H5P_DEFAULT);
   const hid_t bands_type = H5Aget_type(bands);
-  std::vector<char> text(H5Tget_size(bands_type) + 1, '\0');
+  // Schema 2: an array of three fixed-length strings, as h5py reads a list.
+  const size_t size = H5Tget_size(bands_type);
+  std::vector<char> text(3 * size + 1, '\0');
   H5Aread(bands, bands_type, text.data());
-  EXPECT_STREQ(text.data(), "B,V,R");
+  EXPECT_STREQ(text.data(), "B");
+  EXPECT_STREQ(text.data() + size, "V");
+  EXPECT_STREQ(text.data() + 2 * size, "R");
+  const hid_t albedo = H5Aopen(file, "albedo_B", H5P_DEFAULT);  // a string entry in make_metadata
+  const hid_t albedo_type = H5Aget_type(albedo);
+  EXPECT_EQ(H5Tget_class(albedo_type), H5T_STRING);
+  H5Tclose(albedo_type);
+  H5Aclose(albedo);
+  const hid_t real = H5Aopen(file, "real_key", H5P_DEFAULT);  // a number entry: float64
+  const hid_t real_type = H5Aget_type(real);
+  EXPECT_TRUE(H5Tequal(real_type, H5T_IEEE_F64LE) > 0);
+  double value = 0;
+  H5Aread(real, H5T_NATIVE_DOUBLE, &value);
+  EXPECT_EQ(value, 0.1);
+  H5Tclose(real_type);
+  H5Aclose(real);
+  const hid_t whole = H5Aopen(file, "int_key", H5P_DEFAULT);  // an integer entry: int64
+  const hid_t whole_type = H5Aget_type(whole);
+  EXPECT_TRUE(H5Tequal(whole_type, H5T_STD_I64LE) > 0);
+  H5Tclose(whole_type);
+  H5Aclose(whole);
   EXPECT_GT(H5Aexists(file, "albedo_B"), 0);
   EXPECT_GT(H5Aexists(file, "schema_version"), 0);
   H5Tclose(bands_type);
@@ -459,7 +496,7 @@ TEST_F(ImageFile, MalformedImagesAreRefused) {
 
 TEST_F(ImageFile, BadMetadataIsRefused) {
   const std::string file = path("a.fits");
-  auto with = [](std::vector<std::pair<std::string, std::string>> entries) {
+  auto with = [](MetaEntries entries) {
     ImageMetadata m;
     m.entries = std::move(entries);
     return m;
@@ -696,19 +733,26 @@ TEST_F(RefusedHdf5, MissingUnits) {
 }
 
 TEST_F(RefusedHdf5, WrongSchemaVersion) {
-  const int two = 2;
-  expect_refused([&](hid_t f) { set_attribute(f, "schema_version", H5T_NATIVE_INT, &two); },
-                 {"schema_version", "found 2"});
+  const int three = 3;
+  expect_refused([&](hid_t f) { set_attribute(f, "schema_version", H5T_NATIVE_INT, &three); },
+                 {"schema_version", "found 3"});
 }
 
 TEST_F(RefusedHdf5, ExposureAsAString) {
   expect_refused([](hid_t f) { set_string(f, "exposure", "1"); }, {"exposure", "class string"});
 }
 
-TEST_F(RefusedHdf5, EntryThatIsNotAString) {
-  const double x = 0.6;
-  expect_refused([&](hid_t f) { set_attribute(f, "albedo_V", H5T_NATIVE_DOUBLE, &x); },
-                 {"albedo_V", "string attribute", "class float"});
+TEST_F(RefusedHdf5, EntryThatIsNotANumberOrString) {
+  const unsigned char x = 6;
+  expect_refused(
+      [&](hid_t f) {
+        H5Adelete(f, "albedo_V");
+        const hid_t type = H5Tcreate(H5T_OPAQUE, 1);
+        H5Tset_tag(type, "bytes");
+        set_attribute(f, "albedo_V", type, &x);
+        H5Tclose(type);
+      },
+      {"albedo_V", "integer, float or string attribute", "class other"});
 }
 
 TEST_F(RefusedHdf5, NaNPixel) {
@@ -740,7 +784,7 @@ TEST_F(ImageFile, Hdf5VariableLengthStringsAreRead) {
   H5Fclose(f);
   ImageMetadata m;
   read_image(file, &m);
-  EXPECT_EQ(m.entries, (std::vector<std::pair<std::string, std::string>>{{"observer", "someone else's tool"}}));
+  EXPECT_TRUE(m.entries == (MetaEntries{{"observer", "someone else's tool"}}));
 }
 
 // --- FITS files edited after writing
@@ -771,7 +815,9 @@ class RefusedFits : public ImageFile {
 
 TEST_F(RefusedFits, DamagedDataFailsItsChecksum) {
   const std::string file = path("e.fits");
-  write_image(make_image(4, 3), file, make_metadata(), true);
+  ImageMetadata m = make_metadata();
+  m.scene_text.clear();  // no SCENE extension: the file ends with the pixels
+  write_image(make_image(4, 3), file, m, true);
   std::string bytes = file_bytes(file);
   bytes[bytes.size() - 2880 + 5] ^= 0x10;  // inside the pixels
   std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes;

@@ -102,7 +102,7 @@ RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
   if (any)
     for (size_t k = 0; k < star_x.size(); ++k) in.stars.push_back(BakedStar{sb.stars[k], &bake.tau_v[k]});
   in.camera = camera;
-  in.exposure = static_cast<float>(scene.camera.exposure);
+  in.exposure = 1.0f;  // science pixels: the exposure goes in the metadata
   in.step = static_cast<float>(spec.step_texels * map.texel);
   in.skip = skip;
   AxialRenderStats stats;

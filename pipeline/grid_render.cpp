@@ -107,7 +107,7 @@ RenderOutput render_prepared(const PreparedGrid& p, const CameraSettings& settin
   const Camera camera = make_camera(settings);
   RenderInputs in = p.inputs;
   in.camera = camera;
-  in.exposure = static_cast<float>(settings.exposure);
+  in.exposure = 1.0f;  // science pixels: the exposure goes in the metadata
   std::unique_ptr<Progress> bar;
   if (p.options.progress && p.options.backend == Backend::Cpu)
     bar = std::make_unique<Progress>("render", uint64_t(camera.height));
@@ -126,9 +126,9 @@ RenderOutput render_prepared(const PreparedGrid& p, const CameraSettings& settin
     out.report.render_seconds += r.render_seconds;
     out.report.table_clamps += r.table_clamps;
   }
-  draw_scene_stars(scene, p.bands, camera, settings.exposure, out.image);
+  draw_scene_stars(scene, p.bands, camera, 1.0, out.image);
   out.metadata = scene_metadata(scene, p.bands, settings, p.report.mode);
-  out.metadata.entries.push_back({"pyramid_levels", std::to_string(scene.pyramid_levels)});
+  out.metadata.entries.push_back({"pyramid_levels", scene.pyramid_levels});
   out.metadata.entries.push_back({"multiple_scattering", multiple_scattering_text(out.report)});
   return out;
 }

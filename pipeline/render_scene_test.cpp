@@ -2,6 +2,8 @@
 // inputs assembled by hand from the same pieces, its errors name the scene key
 // or option field, and its report says what it computed.
 #include "pipeline/render_scene.h"
+#include "pipeline/run_setup.h"
+#include "illumination/passband.h"
 
 #include <gtest/gtest.h>
 
@@ -67,7 +69,7 @@ TEST_F(RenderScene, IsTheRenderersImageOnItsInputs) {
   const DiffuseField field = bake_diffuse(s.density, diffuse_bands, sb.stars, diffuse, Backend::Cpu);
   in.diffuse = &field;
   in.camera = make_camera(s.camera);
-  in.exposure = 0.02f;
+  in.exposure = 1.0f;  // the pixels are radiance whatever camera.exposure says (0.02 here)
   const Image expected = render_cpu(in, nullptr);
   ASSERT_EQ(out.image.pixels.size(), expected.pixels.size());
   for (int b = 0; b < 3; ++b) EXPECT_TRUE(same_plane(out.image, expected, b)) << "band " << b;
@@ -97,6 +99,117 @@ TEST_F(RenderScene, IsTheRenderersImageOnItsInputs) {
   bool has_mode = false;
   for (const auto& [key, value] : out.metadata.entries) has_mode = has_mode || (key == "mode" && value == "exact");
   EXPECT_TRUE(has_mode);
+  EXPECT_EQ(out.metadata.exposure, 0.02);  // recorded, not applied
+}
+
+const MetaValue* find_entry(const ImageMetadata& m, const std::string& key) {
+  for (const auto& [k, v] : m.entries)
+    if (k == key) return &v;
+  return nullptr;
+}
+
+double number_entry(const ImageMetadata& m, const std::string& key) {
+  const MetaValue* v = find_entry(m, key);
+  EXPECT_TRUE(v != nullptr && v->is_number()) << key;
+  return v != nullptr ? v->number() : std::nan("");
+}
+
+// Issue 16: the metadata an astronomer needs, typed, from the scene and the
+// pipeline's own numbers (not from a file written by the code under test).
+TEST_F(RenderScene, MetadataRecordsTheRunTyped) {
+  const Scene s = load_scene(write_text("meta.toml", "[density]\nprocedural = { n = 16, size_pc = 2.0 }\n"
+                                                     "[[stars]]\nname = \"central\"\nposition = [0.5, 0.25, -0.5]\n"
+                                                     "luminosity_lsun = 2e5\nclass = \"O5V\"\n"
+                                                     "[camera]\nposition = [1, -2.5, 1]\nlook_at = [1, 1, 1]\nwidth = 20\nheight = 16\nexposure = 0.02\n"),
+                             {"dust.albedo={B = 0.6, V = 0.7, R = 0.6}"});
+  const SceneBands sb = scene_bands(s);
+  const ImageMetadata m = pipeline_detail::scene_metadata(s, sb, s.camera, "exact");
+  EXPECT_EQ(m.units, "solLum pc-2 sr-1");
+  EXPECT_EQ(m.exposure, 0.02);
+  EXPECT_EQ(number_entry(m, "albedo_V"), 0.7);
+  EXPECT_EQ(number_entry(m, "albedo_B"), s.dust.albedo[0]);
+  EXPECT_EQ(number_entry(m, "R_V"), s.dust.R_V);
+  EXPECT_EQ(number_entry(m, "ext_V"), 1.0);
+  EXPECT_EQ(find_entry(m, "cam_width")->kind, MetaValue::Kind::Integer);
+  EXPECT_EQ(number_entry(m, "cam_height"), 16);
+  EXPECT_EQ(number_entry(m, "cam_fov_deg"), s.camera.fov_deg);
+  EXPECT_EQ(number_entry(m, "stars"), 1);
+  EXPECT_EQ(find_entry(m, "star1_name")->text, "central");
+  EXPECT_EQ(find_entry(m, "star1_class")->text, "O5V");
+  EXPECT_EQ(number_entry(m, "star1_x_pc"), 0.5);
+  EXPECT_EQ(number_entry(m, "star1_z_pc"), -0.5);
+  EXPECT_EQ(number_entry(m, "star1_L_Lsun"), 2e5);
+  EXPECT_EQ(number_entry(m, "star1_T_K"), s.stars[0].temperature_K);
+  for (size_t b = 0; b < 3; ++b) {
+    EXPECT_EQ(number_entry(m, "star1_P_" + s.bands[b]), double(sb.stars[0].power[b]));
+    // The pivot wavelength lies inside the filter, near its mean.
+    const double pivot = number_entry(m, "pivot_nm_" + s.bands[b]);
+    EXPECT_NEAR(pivot, mean_wavelength_nm(sb.filters[b]), 15.0) << s.bands[b];
+  }
+  EXPECT_LT(number_entry(m, "pivot_nm_B"), number_entry(m, "pivot_nm_V"));
+  EXPECT_LT(number_entry(m, "pivot_nm_V"), number_entry(m, "pivot_nm_R"));
+  EXPECT_EQ(find_entry(m, "DATE")->text.size(), 19u);
+  EXPECT_EQ(find_entry(m, "software")->text.rfind("nebula ", 0), 0u);
+  EXPECT_FALSE(find_entry(m, "git_commit")->text.empty());
+  // The resolved scene: the override is in it and it loads as the same scene.
+  EXPECT_NE(m.scene_text.find("albedo = { B = "), std::string::npos) << m.scene_text;
+  const Scene again = load_scene_text(m.scene_text, "resolved", path(""));
+  EXPECT_EQ(again.dust.albedo, s.dust.albedo);
+  EXPECT_EQ(again.stars[0].name, "central");
+}
+
+// The world coordinates agree with the rays the camera traces: the angle of a
+// pixel's ray from the view axis (perspective: TAN, fisheye: ARC), or its
+// offset across the view (orthographic).
+TEST(CameraWcs, MatchesTheCameraRays) {
+  constexpr double kDeg = 180.0 / 3.14159265358979323846;
+  for (const Projection p : {Projection::Perspective, Projection::Fisheye, Projection::Orthographic}) {
+    CameraSettings c;
+    c.projection = p;
+    c.position = {1, -3, 0.5};
+    c.look_at = {0.5, 0.5, 0};
+    c.up = {0, 0, 1};
+    c.fov_deg = 35;
+    c.ortho_width = 4;
+    c.width = p == Projection::Fisheye ? 64 : 80;
+    c.height = 64;
+    const Camera cam = make_camera(c);
+    MetaEntries w = pipeline_detail::camera_wcs(c);
+    auto get = [&](const std::string& k) {
+      for (const auto& [key, v] : w)
+        if (key == k) return v;
+      ADD_FAILURE() << k;
+      return MetaValue();
+    };
+    const double crpix1 = get("CRPIX1").number(), crpix2 = get("CRPIX2").number();
+    const double d1 = get("CDELT1").number(), d2 = get("CDELT2").number();
+    for (const auto& [px, py] : std::vector<std::pair<int, int>>{{0, 0}, {10, 50}, {40, 31}, {63, 5}, {30, 60}}) {
+      // FITS pixel centres: x + 1, and rows counted from the bottom.
+      const double x = d1 * (px + 1 - crpix1), y = d2 * (c.height - py - crpix2);
+      Vec3 origin, dir;
+      if (!cam.ray(px, py, origin, dir)) continue;
+      if (p == Projection::Orthographic) {
+        EXPECT_EQ(get("CUNIT1").text, "pc");
+        EXPECT_NEAR(dot(origin - cam.position, cam.right), x, 1e-5);
+        EXPECT_NEAR(dot(origin - cam.position, cam.up), y, 1e-5);
+        continue;
+      }
+      const double across = std::hypot(double(dot(dir, cam.right)), double(dot(dir, cam.up)));
+      const double angle = std::atan2(across, double(dot(dir, cam.forward)));
+      const double r = std::hypot(x, y);
+      if (p == Projection::Perspective) {
+        EXPECT_EQ(get("CTYPE1").text, "OFLN-TAN");
+        EXPECT_NEAR(std::tan(angle) * kDeg, r, 1e-4) << px << "," << py;
+      } else {
+        EXPECT_EQ(get("CTYPE1").text, "OFLN-ARC");
+        EXPECT_NEAR(angle * kDeg, r, 2e-3) << px << "," << py;
+      }
+      // The direction on the sky: +x along the camera's right, +y along its up.
+      if (r > 0) {
+        EXPECT_NEAR(dot(dir, cam.right) / std::hypot(dot(dir, cam.right), dot(dir, cam.up)), x / r, 1e-4);
+      }
+    }
+  }
 }
 
 // A table named for one band changes that band's plane and no other.
@@ -186,7 +299,9 @@ TEST_F(RenderScene, AxialMapsAndTheTruthRunThroughTheSamePipeline) {
   EXPECT_EQ(truth.variance.pixels.size(), truth.image.pixels.size());
   ASSERT_TRUE(truth.report.truth.has_value());
   EXPECT_EQ(truth.report.truth->paths, 20u * 16u * 4u * 3u);
-  EXPECT_EQ(truth.variance_metadata.units, "(L_sun pc^-2 sr^-1 x exposure)^2, variance of the pixel mean");
+  EXPECT_EQ(truth.variance_metadata.units, "solLum2 pc-4 sr-2");
+  EXPECT_EQ(truth.metadata.units, "solLum pc-2 sr-1");
+  EXPECT_EQ(truth.metadata.exposure, 0.02);
   t.axial_voxels = 64;
   const TruthRenderOutput axial_truth = truth_scene(axial, t);
   ASSERT_TRUE(axial_truth.report.truth.has_value());

@@ -1,6 +1,10 @@
 #include "pipeline/run_setup.h"
 
+#include <cmath>
+#include <ctime>
+
 #include "core/error.h"
+#include "illumination/passband.h"
 #include "core/progress.h"
 #include "pipeline/render_scene.h"
 #include "raycast/point_stars.h"
@@ -29,21 +33,113 @@ RunReport begin_report(const Scene& scene, const SceneBands& bands, const std::s
   return r;
 }
 
+double pivot_wavelength_nm(const Passband& p) {
+  const double up = passband_integral(p, [](double l) { return l; }, kPassbandSubdivisions);
+  const double down = passband_integral(p, [](double l) { return 1.0 / l; }, kPassbandSubdivisions);
+  return std::sqrt(up / down);
+}
+
+MetaEntries camera_wcs(const CameraSettings& c) {
+  MetaEntries w;
+  constexpr double kDeg = 180.0 / 3.14159265358979323846;
+  // Pixel centres are integers in FITS, (1, 1) the lower left; the camera
+  // axis passes between the middle pixels of an even image.
+  const double crpix1 = 0.5 * (c.width + 1), crpix2 = 0.5 * (c.height + 1);
+  std::string type1, type2, unit;
+  double step = 0;
+  if (c.projection == Projection::Orthographic) {
+    type1 = "OFFSET_X";
+    type2 = "OFFSET_Y";
+    unit = "pc";
+    step = c.ortho_width / c.width;  // square pixels
+  } else if (c.projection == Projection::Perspective) {
+    // A pinhole camera is the gnomonic (TAN) projection; square pixels.
+    type1 = "OFLN-TAN";
+    type2 = "OFLT-TAN";
+    unit = "deg";
+    step = kDeg * 2.0 * std::tan(0.5 * c.fov_deg / kDeg) / c.height;
+  } else {
+    // The dome master is azimuthal equidistant (ARC): 90 degrees at the rim.
+    type1 = "OFLN-ARC";
+    type2 = "OFLT-ARC";
+    unit = "deg";
+    step = 180.0 / c.height;
+  }
+  w.push_back({"WCSAXES", 3});
+  w.push_back({"CTYPE1", type1});
+  w.push_back({"CTYPE2", type2});
+  w.push_back({"CTYPE3", "BAND"});
+  w.push_back({"CUNIT1", unit});
+  w.push_back({"CUNIT2", unit});
+  w.push_back({"CRPIX1", crpix1});
+  w.push_back({"CRPIX2", crpix2});
+  w.push_back({"CRPIX3", 1.0});
+  w.push_back({"CRVAL1", 0.0});
+  w.push_back({"CRVAL2", 0.0});
+  w.push_back({"CRVAL3", 1.0});
+  w.push_back({"CDELT1", step});
+  w.push_back({"CDELT2", step});
+  w.push_back({"CDELT3", 1.0});
+  if (c.projection != Projection::Orthographic) w.push_back({"LONPOLE", 180.0});
+  return w;
+}
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%S", &tm);
+  return text;
+}
+
 ImageMetadata scene_metadata(const Scene& scene, const SceneBands& bands, const CameraSettings& camera,
                              const std::string& mode) {
   ImageMetadata meta;
-  meta.units = "L_sun pc^-2 sr^-1 x exposure";
-  meta.exposure = 1.0;  // the camera exposure is already in the pixels
-  for (size_t b = 0; b < scene.bands.size(); ++b) {
-    meta.entries.push_back({"albedo_" + scene.bands[b], to_text(scene.dust.albedo[b])});
-    meta.entries.push_back({"g_" + scene.bands[b], to_text(scene.dust.g[b])});
-    meta.entries.push_back({"ext_" + scene.bands[b], to_text(bands.bands[b].extinction_ratio)});
-  }
-  meta.entries.push_back({"R_V", to_text(scene.dust.R_V)});
-  meta.entries.push_back({"camera", std::string(to_string(camera.projection)) + " " +
-                                        std::to_string(camera.width) + "x" + std::to_string(camera.height)});
+  meta.units = kRadianceUnit;
+  // The pixels are radiance; the exposure is a display setting, applied
+  // only when the image is tone-mapped (PNG).
+  meta.exposure = camera.exposure;
+  meta.entries = camera_wcs(camera);
+  meta.entries.push_back({"DATE", utc_now()});
+  meta.entries.push_back({"software", std::string("nebula ") + NEBULA_VERSION});
+  meta.entries.push_back({"git_commit", NEBULA_GIT_COMMIT});
   meta.entries.push_back({"scene", scene.path});
   meta.entries.push_back({"mode", mode});
+  for (size_t b = 0; b < scene.bands.size(); ++b) {
+    const std::string& name = scene.bands[b];
+    if (b < bands.filters.size()) meta.entries.push_back({"pivot_nm_" + name, pivot_wavelength_nm(bands.filters[b])});
+    meta.entries.push_back({"albedo_" + name, scene.dust.albedo[b]});
+    meta.entries.push_back({"g_" + name, scene.dust.g[b]});
+    meta.entries.push_back({"ext_" + name, double(bands.bands[b].extinction_ratio)});
+  }
+  meta.entries.push_back({"R_V", scene.dust.R_V});
+  meta.entries.push_back({"ext_law", to_string(scene.dust.law)});
+  meta.entries.push_back({"cam_kind", to_string(camera.projection)});
+  meta.entries.push_back({"cam_width", camera.width});
+  meta.entries.push_back({"cam_height", camera.height});
+  const char* axes[3] = {"x", "y", "z"};
+  auto part = [](const Vec3& v, int i) { return double(i == 0 ? v.x : i == 1 ? v.y : v.z); };
+  for (int i = 0; i < 3; ++i) meta.entries.push_back({std::string("cam_") + axes[i] + "_pc", part(camera.position, i)});
+  for (int i = 0; i < 3; ++i)
+    meta.entries.push_back({std::string("cam_look_") + axes[i] + "_pc", part(camera.look_at, i)});
+  for (int i = 0; i < 3; ++i) meta.entries.push_back({std::string("cam_up_") + axes[i], part(camera.up, i)});
+  if (camera.projection == Projection::Perspective) meta.entries.push_back({"cam_fov_deg", camera.fov_deg});
+  if (camera.projection == Projection::Orthographic) meta.entries.push_back({"cam_ortho_pc", camera.ortho_width});
+  meta.entries.push_back({"stars", static_cast<int>(scene.stars.size())});
+  for (size_t k = 0; k < scene.stars.size(); ++k) {
+    const SceneStar& star = scene.stars[k];
+    const std::string s = "star" + std::to_string(k + 1) + "_";
+    if (!star.name.empty()) meta.entries.push_back({s + "name", star.name});
+    for (int i = 0; i < 3; ++i) meta.entries.push_back({s + axes[i] + "_pc", part(star.position, i)});
+    if (!star.spectral_class.empty()) meta.entries.push_back({s + "class", star.spectral_class});
+    meta.entries.push_back({s + "T_K", star.temperature_K});
+    meta.entries.push_back({s + "L_Lsun", star.luminosity_lsun});
+    if (k < bands.stars.size())
+      for (size_t b = 0; b < scene.bands.size() && b < bands.stars[k].power.size(); ++b)
+        meta.entries.push_back({s + "P_" + scene.bands[b], double(bands.stars[k].power[b])});
+  }
+  meta.scene_text = scene.resolved_toml;
   return meta;
 }
 

@@ -30,8 +30,22 @@ inline double seconds_since(std::chrono::steady_clock::time_point t) {
 RunReport begin_report(const Scene& scene, const SceneBands& bands, const std::string& renderer, Backend backend,
                        const std::vector<bool>& scatters = {});
 
-// Units, per-band albedo, g and extinction ratio, R_V, the camera, the scene
-// file and the render mode.
+// The unit of every rendered image: radiance per band, in a form FITS and
+// astropy.units parse (docs/image_files.md).
+inline const char* const kRadianceUnit = "solLum pc-2 sr-1";
+inline const char* const kRadianceVarianceUnit = "solLum2 pc-4 sr-2";
+
+// The FITS world coordinates of the camera (CTYPE, CRPIX, ...): offsets in pc
+// for the orthographic camera, angles from the view axis (TAN, ARC) for the
+// perspective and fisheye cameras (docs/image_files.md).
+MetaEntries camera_wcs(const CameraSettings& camera);
+// sqrt(integral T lambda / integral T / lambda), nm.
+double pivot_wavelength_nm(const Passband& passband);
+
+// Units, the camera's exposure, its world coordinates and settings, the date,
+// the software and commit, per-band pivot wavelength, albedo, g and extinction
+// ratio, R_V, the stars with their band powers, the scene file and its
+// resolved text, and the render mode.
 ImageMetadata scene_metadata(const Scene& scene, const SceneBands& bands, const CameraSettings& camera,
                              const std::string& mode);
 

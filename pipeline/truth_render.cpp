@@ -72,7 +72,7 @@ TruthRenderOutput truth_scene(const Scene& scene, const TruthOptions& o) {
     cs.up = frame.vector(cs.up);
     in.camera = make_camera(cs);
   }
-  in.exposure = static_cast<float>(scene.camera.exposure);
+  in.exposure = 1.0f;  // science pixels: the exposure goes in the metadata
   in.spp = o.spp;
   in.seed = o.seed;
   in.max_orders = o.max_orders;
@@ -87,7 +87,7 @@ TruthRenderOutput truth_scene(const Scene& scene, const TruthOptions& o) {
   if (bar) bar->finish();
   // Stars seen directly: the same deterministic drawing as the fast renderer
   // (exact transmittance, a Gaussian PSF); no variance.
-  if (!scene.axial) draw_scene_stars(scene, sb, camera, scene.camera.exposure, result.image);
+  if (!scene.axial) draw_scene_stars(scene, sb, camera, 1.0, result.image);
 
   TruthRenderOutput out;
   out.image = std::move(result.image);
@@ -102,7 +102,7 @@ TruthRenderOutput truth_scene(const Scene& scene, const TruthOptions& o) {
                            (o.max_orders ? " orders<=" + std::to_string(o.max_orders) : "") + traced;
   out.metadata = scene_metadata(scene, sb, scene.camera, mode);
   out.variance_metadata = out.metadata;
-  out.variance_metadata.units = "(L_sun pc^-2 sr^-1 x exposure)^2, variance of the pixel mean";
+  out.variance_metadata.units = kRadianceVarianceUnit;  // of the pixel mean
   RunReport& r = out.report;
   r = begin_report(scene, sb, "truth", o.backend);
   r.mode = mode;

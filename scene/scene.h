@@ -94,6 +94,9 @@ struct SceneInput {
 
 struct Scene {
   std::string path;  // the scene file as given ("demo" for demo_scene())
+  // The scene file's TOML after the overrides, as toml++ prints it (empty
+  // for a scene built in code): what images record as their scene.
+  std::string resolved_toml;
   std::vector<SceneInput> inputs;  // every file the scene reads (load_scene fills it)
   std::vector<std::string> bands{"B", "V", "R"};
   DensityGrid density;  // tau_v per voxel (empty for an axial scene)

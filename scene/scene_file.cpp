@@ -801,7 +801,11 @@ Scene parse_scene(const std::string& text, const std::string& name, const fs::pa
   Parser parser(name, base);
   parser.note_file_tables(root);
   for (const std::string& o : overrides) parser.apply_override(root, o);
-  return parser.build(root);
+  std::ostringstream resolved;
+  resolved << toml::toml_formatter(root);
+  Scene scene = parser.build(root);
+  scene.resolved_toml = resolved.str();
+  return scene;
 }
 
 }  // namespace

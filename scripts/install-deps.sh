@@ -7,7 +7,7 @@ packages=(
   build-essential cmake pkg-config
   libtbb-dev libhdf5-dev libcli11-dev libgtest-dev
   libtomlplusplus-dev libcfitsio-dev libopenimageio-dev
-  python3-numpy python3-matplotlib python3-h5py
+  python3-numpy python3-matplotlib python3-h5py python3-venv
 )
 
 missing=()

@@ -5,7 +5,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+# astropy (PyPI) for the FITS test validation.fits_astropy, in a virtual
+# environment inside the build folder, installed once and reused.
+py=build/pyenv/bin/python
+if ! "$py" -c "import astropy, numpy" 2>/dev/null; then
+  /usr/bin/python3 -m venv build/pyenv
+  "$py" -m pip install --quiet --disable-pip-version-check astropy
+fi
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DNEBULA_PYTHON="$PWD/$py"
 cmake --build build -j"$(nproc)"
 cd build
 ctest --output-on-failure -j"$(nproc)"

@@ -114,8 +114,13 @@ def write_png(h5_path, png_path):
 
     with h5py.File(h5_path, "r") as f:
         image = f["image"][()].astype(np.float64)  # [band][y][x], row 0 at the top
-        bands = f.attrs["bands"]
-        bands = (bands.decode() if isinstance(bands, bytes) else str(bands)).split(",")
+        bands = f.attrs["bands"]  # an array of names (schema 2) or "B,V,R" (schema 1)
+        if isinstance(bands, (bytes, str)):
+            bands = (bands.decode() if isinstance(bands, bytes) else bands).split(",")
+        else:
+            bands = [b.decode() if isinstance(b, bytes) else str(b) for b in bands]
+        # The pixels are radiance; the scene's camera.exposure is stored beside them (schema 2; schema 1
+        # files had it in the pixels and store 1).
         exposure = float(f.attrs.get("exposure", 1.0))
     if len(bands) == 1:
         planes = [image[0]] * 3
