@@ -10,7 +10,8 @@ bash scripts/install-deps.sh
 py=build/pyenv/bin/python
 if ! "$py" -c "import astropy, numpy" 2>/dev/null; then
   /usr/bin/python3 -m venv build/pyenv
-  "$py" -m pip install --quiet --disable-pip-version-check astropy
+  "$py" -m pip install --quiet --disable-pip-version-check astropy ||
+    echo "test.sh: warning: astropy could not be installed from PyPI; validation.fits_astropy will report a skip" >&2
 fi
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DNEBULA_PYTHON="$PWD/$py"
 cmake --build build -j"$(nproc)"
