@@ -37,7 +37,12 @@ void check_R_V(double R_V) {
 }  // namespace
 
 const char* to_string(ExtinctionLaw law) {
-  return law == ExtinctionLaw::CCM89 ? "CCM89" : "ODonnell94";
+  switch (law) {
+    case ExtinctionLaw::CCM89: return "CCM89";
+    case ExtinctionLaw::ODonnell94: return "ODonnell94";
+    case ExtinctionLaw::Grey: return "grey";
+  }
+  return "?";
 }
 
 ExtinctionCoefficients extinction_coefficients(double x, ExtinctionLaw law) {
@@ -61,6 +66,7 @@ double extinction_ratio_at(double wavelength_nm, double R_V, ExtinctionLaw law) 
   check_R_V(R_V);
   if (!(wavelength_nm > 0.0) || !std::isfinite(wavelength_nm))
     throw Error("wavelength " + to_text(wavelength_nm) + " nm is not a positive finite number");
+  if (law == ExtinctionLaw::Grey) return 1.0;
   const ExtinctionCoefficients c = extinction_coefficients(1000.0 / wavelength_nm, law);
   return c.a + c.b / R_V;
 }

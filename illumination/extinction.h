@@ -9,8 +9,9 @@ namespace nebula {
 // A(lambda)/A(V) = a(x) + b(x)/R_V, x = 1/lambda in 1/um (Cardelli, Clayton &
 // Mathis 1989, ApJ 345, 245). ODonnell94 replaces the optical polynomials
 // (1.1 <= x < 3.3) by O'Donnell's (1994, ApJ 422, 158); the infrared is CCM's
-// in both.
-enum class ExtinctionLaw { CCM89, ODonnell94 };
+// in both. Grey dust extinguishes every wavelength alike (A/A_V = 1), as
+// radiative-transfer benchmarks at one wavelength assume; R_V plays no part.
+enum class ExtinctionLaw { CCM89, ODonnell94, Grey };
 
 const char* to_string(ExtinctionLaw law);
 

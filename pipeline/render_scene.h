@@ -73,8 +73,17 @@ struct PreparedGrid {
   PreparedPyramid pyramid;
   RenderInputs inputs;  // everything but the camera and exposure
   RunReport report;     // the work so far
+  // What the bakes and the diffuse field were computed from (empty: never
+  // reused), compared by the re-preparing overload below.
+  std::string bake_key, diffuse_key;
 };
 PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& options);
+// The same after an edit: the star bakes (when the grid and the stars'
+// positions are unchanged) and the diffuse field (when, besides, the bands'
+// dust, tables and the stars' powers and the field's settings are) move over
+// from `previous` instead of being computed again; the report marks them
+// reused. Grids are compared by what they were made from (Scene::grid_source).
+PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& options, PreparedGrid&& previous);
 RenderOutput render_prepared(const PreparedGrid& prepared, const CameraSettings& camera);
 
 struct TruthOptions {

@@ -40,11 +40,13 @@ struct BakeReport {
   size_t stars = 0;
   uint64_t cells = 0;   // voxels, or texels of an axial map
   double seconds = 0;
+  bool reused = false;  // taken over from an earlier preparation (prepare_grid after an edit)
 };
 
 // The diffuse field's bake (diffuse/diffuse_bake.h).
 struct DiffuseReport {
   bool done = false;
+  bool reused = false;  // taken over from an earlier preparation (its figures are that bake's)
   int order = 0;
   GridShape cells;             // the field's cells ({along the axis, from it, 1} for an axial map)
   int voxels_per_cell = 1;     // along each axis

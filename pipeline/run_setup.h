@@ -64,6 +64,14 @@ DiffuseReport diffuse_report(const std::vector<DiffuseBand>& bands, const Diffus
                              double wall_seconds);
 // What an image's light between voxels (or cells) came from, for its metadata.
 std::string multiple_scattering_text(const RunReport& r);
+
+// Pixel-area sampling for the fast renderers (render.samples_per_pixel =
+// k^2): they trace the frame at k times the resolution, a k x k grid of
+// sub-pixel rays at the centres of equal strata, and each pixel is the mean
+// of its k^2 rays. supersampled_camera is that finer camera (k = 1: the same).
+CameraSettings supersampled_camera(const CameraSettings& camera, int samples_per_pixel);
+// The mean of each k x k block of `fine` (k * width x k * height).
+Image box_downsample(const Image& fine, int k);
 // A progress bar over the bake's photons on the CPU (null otherwise).
 std::unique_ptr<Progress> diffuse_progress(const std::vector<DiffuseBand>& bands, const DiffuseBakeOptions& options,
                                            const RenderOptions& o);

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <set>
 
+#include "core/bands.h"
 #include "core/error.h"
 #include "illumination/filters.h"
 #include "illumination/star.h"
@@ -92,10 +93,19 @@ std::optional<SceneIssue> star_issue(const SceneStar& star, const std::string& k
 }  // namespace
 
 std::optional<SceneIssue> band_issue(const std::string& band) {
-  if (is_renderable_filter(band)) return std::nullopt;
+  if (is_renderable_filter(band) || band == kGreyBand) return std::nullopt;
   std::string known;
   for (const std::string& name : renderable_filters()) known += (known.empty() ? "" : ", ") + name;
-  return SceneIssue{"bands", "'" + band + "' is not a known band (known: " + known + ")"};
+  return SceneIssue{"bands", "'" + band + "' is not a known band (known: " + known + ", " + kGreyBand + ")"};
+}
+
+std::optional<SceneIssue> samples_per_pixel_issue(int n) {
+  const int side = samples_per_pixel_side(n);
+  if (n < 1 || n > kMaxSamplesPerPixel || side * side != n)
+    return SceneIssue{"render.samples_per_pixel", "is " + std::to_string(n) +
+                                                      "; must be a square in 1..256 (1, 4, 9, 16, ...: k x k "
+                                                      "stratified rays per pixel)"};
+  return std::nullopt;
 }
 
 std::optional<SceneIssue> settings_issue(const Scene& s) {
@@ -139,6 +149,7 @@ std::optional<SceneIssue> settings_issue(const Scene& s) {
   if (s.diffuse.photons < 1 || s.diffuse.photons > 0xFFFFFFFFull)
     return SceneIssue{"render.diffuse_photons",
                       "is " + std::to_string(s.diffuse.photons) + "; must be in 1..4294967295 (per band)"};
+  if (auto issue = samples_per_pixel_issue(s.samples_per_pixel)) return issue;
   return std::nullopt;
 }
 

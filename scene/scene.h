@@ -98,6 +98,9 @@ struct Scene {
   // for a scene built in code): what images record as their scene.
   std::string resolved_toml;
   std::vector<SceneInput> inputs;  // every file the scene reads (load_scene fills it)
+  // What the density and emission grids were made from, as text (load_scene
+  // fills it; empty for a scene built in code): equal texts, equal grids.
+  std::string grid_source;
   std::vector<std::string> bands{"B", "V", "R"};
   DensityGrid density;  // tau_v per voxel (empty for an axial scene)
   std::optional<AxialSpec> axial;  // set instead of a density grid
@@ -119,7 +122,19 @@ struct Scene {
   // for multiple_scattering = Pyramid; at most the grid allows
   // (multires/volume_pyramid.h), checked by the renderer.
   int pyramid_levels = 0;
+  // Rays per pixel ([render] samples_per_pixel): k x k stratified over the
+  // pixel's area, so a pixel is its area's mean, not its centre's value (the
+  // 1/d cusp next to a star). A square in 1..kMaxSamplesPerPixel.
+  int samples_per_pixel = 1;
 };
+
+constexpr int kMaxSamplesPerPixel = 256;
+// k for samples_per_pixel = k^2 (the rounded square root; check the square).
+inline int samples_per_pixel_side(int n) {
+  int k = 1;
+  while ((k + 1) * (k + 1) <= n) ++k;
+  return k;
+}
 
 // Checks a Scene built in code (load_scene checks the same rules and more):
 // bands, per-band vector sizes, albedo, g, R_V, stars, camera, output, grid

@@ -28,6 +28,7 @@ std::optional<SceneIssue> grids_issue(const Scene& scene);
 
 // A band a scene may render (illumination/filters.h), or its issue.
 std::optional<SceneIssue> band_issue(const std::string& band);
+std::optional<SceneIssue> samples_per_pixel_issue(int n);
 
 inline std::string number_text(double v) { return to_text(v); }
 

@@ -61,7 +61,8 @@ const char* type_name(const toml::node& n) {
 const std::initializer_list<std::string_view> kTopKeys = {"bands",  "density", "emission", "dust",
                                                           "stars",  "camera",  "output", "render", "axial"};
 const std::initializer_list<std::string_view> kRenderKeys = {
-    "levels", "multiple_scattering", "diffuse_order", "diffuse_cells", "diffuse_photons", "diffuse_seed"};
+    "levels", "multiple_scattering", "diffuse_order", "diffuse_cells", "diffuse_photons", "diffuse_seed",
+    "samples_per_pixel"};
 const std::initializer_list<std::string_view> kAxialKeys = {
     "synthetic", "file", "image", "dataset", "emission_prefix", "tau_channel", "emission_channels", "nx", "nr",
     "length_pc", "tau_scale", "emission_scale", "origin", "axis", "skip", "step_texels"};
@@ -143,7 +144,7 @@ class Parser {
   }
 
   void apply_override(toml::table& root, const std::string& text);
-  Scene build(toml::table& root);
+  Scene build(toml::table& root, const Scene* reuse_grids = nullptr);
 
  private:
   // ------------------------------------------------ typed access
@@ -566,8 +567,10 @@ DustParams Parser::parse_dust(const toml::table& root, const std::vector<std::st
       dust.law = ExtinctionLaw::CCM89;
     else if (lower(law) == "odonnell94")
       dust.law = ExtinctionLaw::ODonnell94;
+    else if (lower(law) == "grey" || lower(law) == "gray")
+      dust.law = ExtinctionLaw::Grey;
     else
-      fail("dust.law", "'" + law + "' is not a known law (known: ccm89, odonnell94)");
+      fail("dust.law", "'" + law + "' is not a known law (known: ccm89, odonnell94, grey)");
   }
   if (const toml::node* tb = t.get("tables")) {
     const toml::table& tables = table_at(*tb, "dust.tables");
@@ -700,6 +703,10 @@ void Parser::parse_render(const toml::table& root, Scene& scene) const {
   };
   count("diffuse_photons", d.photons);
   count("diffuse_seed", d.seed);
+  if (const toml::node* v = t.get("samples_per_pixel")) {
+    scene.samples_per_pixel = small_integer(*v, "render.samples_per_pixel");
+    if (auto issue = scene_detail::samples_per_pixel_issue(scene.samples_per_pixel)) fail(issue->key, issue->reason);
+  }
 }
 
 void Parser::load_grids(const DensityPlan& density, const std::optional<EmissionPlan>& emission,
@@ -736,7 +743,7 @@ void Parser::load_grids(const DensityPlan& density, const std::optional<Emission
   }
 }
 
-Scene Parser::build(toml::table& root) {
+Scene Parser::build(toml::table& root, const Scene* reuse_grids) {
   known_keys(root, "", kTopKeys);
   Scene scene;
   scene.path = name_;
@@ -782,13 +789,28 @@ Scene Parser::build(toml::table& root) {
   for (size_t b = 0; b < scene.dust.table_files.size(); ++b)
     if (!scene.dust.table_files[b].empty())
       scene.inputs.push_back({"dust.tables." + scene.bands[b], scene.dust.table_files[b]});
-  if (!axial) load_grids(density, emission, scene);  // the expensive part, last
+  // What the grids are made of: the [density] and [emission] tables as
+  // printed, the bands (emission grids follow them) and the scene's folder.
+  if (!axial) {
+    std::ostringstream source;
+    source << "base=" << base_.string() << "\nbands=";
+    for (const std::string& b : scene.bands) source << b << ",";
+    if (const toml::table* d = root["density"].as_table()) source << "\n[density]\n" << toml::toml_formatter(*d);
+    if (const toml::table* e = root["emission"].as_table()) source << "\n[emission]\n" << toml::toml_formatter(*e);
+    scene.grid_source = source.str();
+  }
+  if (!axial && reuse_grids && !reuse_grids->grid_source.empty() && reuse_grids->grid_source == scene.grid_source) {
+    scene.density = reuse_grids->density;
+    scene.emission = reuse_grids->emission;
+  } else if (!axial) {
+    load_grids(density, emission, scene);  // the expensive part, last
+  }
   if (const auto issue = scene_detail::grids_issue(scene)) fail(issue->key, issue->reason);
   return scene;
 }
 
 Scene parse_scene(const std::string& text, const std::string& name, const fs::path& base,
-                  const std::vector<std::string>& overrides) {
+                  const std::vector<std::string>& overrides, const Scene* reuse_grids) {
   toml::table root;
   try {
     root = toml::parse(std::string_view(text), std::string_view(name));
@@ -803,7 +825,7 @@ Scene parse_scene(const std::string& text, const std::string& name, const fs::pa
   for (const std::string& o : overrides) parser.apply_override(root, o);
   std::ostringstream resolved;
   resolved << toml::toml_formatter(root);
-  Scene scene = parser.build(root);
+  Scene scene = parser.build(root, reuse_grids);
   scene.resolved_toml = resolved.str();
   return scene;
 }
@@ -811,8 +833,8 @@ Scene parse_scene(const std::string& text, const std::string& name, const fs::pa
 }  // namespace
 
 Scene load_scene_text(const std::string& text, const std::string& name, const std::string& base_dir,
-                      const std::vector<std::string>& overrides) {
-  return parse_scene(text, name, fs::path(base_dir), overrides);
+                      const std::vector<std::string>& overrides, const Scene* reuse_grids) {
+  return parse_scene(text, name, fs::path(base_dir), overrides, reuse_grids);
 }
 
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
@@ -826,7 +848,7 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw Error(path + ": cannot read the scene file");
-  Scene scene = parse_scene(text.str(), path, fs::path(path).parent_path(), overrides);
+  Scene scene = parse_scene(text.str(), path, fs::path(path).parent_path(), overrides, nullptr);
   scene.inputs.insert(scene.inputs.begin(), SceneInput{"scene", path});
   return scene;
 }

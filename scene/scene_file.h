@@ -21,9 +21,14 @@ namespace nebula {
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
 
 // The same, from TOML text; `name` stands for the file in messages and
-// `base_dir` resolves relative data paths.
+// `base_dir` resolves relative data paths. With `reuse_grids`, a scene whose
+// grids come from the same [density] and [emission] tables, bands and folder
+// (Scene::grid_source) copies that scene's grids instead of reading or
+// generating them again (edits and sweeps; files changed on disk meanwhile
+// are not seen).
 Scene load_scene_text(const std::string& text, const std::string& name,
-                      const std::string& base_dir, const std::vector<std::string>& overrides = {});
+                      const std::string& base_dir, const std::vector<std::string>& overrides = {},
+                      const Scene* reuse_grids = nullptr);
 
 // The built-in demo (`nebula render --demo`), equal to scenes/demo.toml: the
 // default procedural nebula (128^3 voxels, 2 pc), one O5V star of 2e5 L_sun
