@@ -63,6 +63,7 @@ int main(int argc, char** argv) {
   nebula::app::add_render_command(app);
   nebula::app::add_truth_command(app);
   nebula::app::add_compare_command(app);
+  nebula::app::add_sweep_command(app);
   nebula::app::add_tabulate_command(app);
   nebula::app::add_table_command(app);
   nebula::app::add_slab_command(app);

@@ -228,6 +228,12 @@ class Reader {
 }  // namespace
 
 void write_fits(const Image& image, const ImageMetadata& metadata, const std::string& file_name) {
+  write_fits_cube({&image}, {}, metadata, file_name);
+}
+
+void write_fits_cube(const std::vector<const Image*>& images, const std::vector<CubeAxis>& cube_axes,
+                     const ImageMetadata& metadata, const std::string& file_name) {
+  const Image& image = *images.front();
   const std::lock_guard<std::mutex> lock(fits_mutex);
   // cfitsio creates the file itself and refuses one that exists. Its
   // "disk file" calls take the name literally, where the plain ones would
@@ -240,8 +246,11 @@ void write_fits(const Image& image, const ImageMetadata& metadata, const std::st
     fits.f = nullptr;
     throw Error("creating the FITS file (" + cfitsio_reason(status) + ")");
   }
-  long axes[3] = {image.width, image.height, static_cast<long>(image.bands.size())};
-  if (fits_create_img(fits.f, FLOAT_IMG, 3, axes, &status) != 0)
+  // NAXIS1..3 = width, height, bands; then the cube's axes, the last (the
+  // fastest varying) first, so that numpy's shape is (first axis, ..., bands, rows, columns).
+  std::vector<long> axes{image.width, image.height, static_cast<long>(image.bands.size())};
+  for (size_t k = cube_axes.size(); k-- > 0;) axes.push_back(static_cast<long>(cube_axes[k].values.size()));
+  if (fits_create_img(fits.f, FLOAT_IMG, static_cast<int>(axes.size()), axes.data(), &status) != 0)
     throw Error("creating the FITS image (" + cfitsio_reason(status) + ")");
 
   bool continued = false;
@@ -272,15 +281,17 @@ void write_fits(const Image& image, const ImageMetadata& metadata, const std::st
   // Plane by plane, top row last (FITS rows go up).
   const size_t width = image.width, plane = image.plane_size();
   std::vector<float> rows(plane);
-  for (size_t b = 0; b < image.bands.size(); ++b) {
-    for (int y = 0; y < image.height; ++y) {
-      const float* source = &image.pixels[b * plane + size_t(y) * width];
-      std::copy(source, source + width, rows.begin() + size_t(image.height - 1 - y) * width);
+  size_t first = 1;
+  for (const Image* each : images)
+    for (size_t b = 0; b < image.bands.size(); ++b, first += plane) {
+      for (int y = 0; y < image.height; ++y) {
+        const float* source = &each->pixels[b * plane + size_t(y) * width];
+        std::copy(source, source + width, rows.begin() + size_t(image.height - 1 - y) * width);
+      }
+      if (fits_write_img(fits.f, TFLOAT, static_cast<LONGLONG>(first), static_cast<LONGLONG>(plane), rows.data(),
+                         &status) != 0)
+        throw Error("writing the pixels (" + cfitsio_reason(status) + ")");
     }
-    if (fits_write_img(fits.f, TFLOAT, static_cast<LONGLONG>(b * plane + 1), static_cast<LONGLONG>(plane),
-                       rows.data(), &status) != 0)
-      throw Error("writing the pixels (" + cfitsio_reason(status) + ")");
-  }
   if (fits_write_chksum(fits.f, &status) != 0)
     throw Error("writing the checksums (" + cfitsio_reason(status) + ")");
 
@@ -294,6 +305,21 @@ void write_fits(const Image& image, const ImageMetadata& metadata, const std::st
                        const_cast<char*>(metadata.scene_text.data()), &status) != 0 ||
         fits_write_chksum(fits.f, &status) != 0)
       throw Error("writing the SCENE extension (" + cfitsio_reason(status) + ")");
+  }
+  // Each cube axis's values: a 1-D double image extension named by its key
+  // (astropy: hdul["dust.albedo"].data).
+  for (size_t k = 0; k < cube_axes.size(); ++k) {
+    const CubeAxis& axis = cube_axes[k];
+    long length[1] = {static_cast<long>(axis.values.size())};
+    const int number = static_cast<int>(3 + cube_axes.size() - k);
+    const std::string comment = "values along NAXIS" + std::to_string(number);
+    if (fits_create_img(fits.f, DOUBLE_IMG, 1, length, &status) != 0 ||
+        fits_write_key_str(fits.f, "EXTNAME", axis.key.c_str(), comment.c_str(), &status) != 0 ||
+        fits_write_key_lng(fits.f, "AXISNUM", number, "the primary image's axis these values label", &status) != 0 ||
+        fits_write_img(fits.f, TDOUBLE, 1, static_cast<LONGLONG>(axis.values.size()),
+                       const_cast<double*>(axis.values.data()), &status) != 0 ||
+        fits_write_chksum(fits.f, &status) != 0)
+      throw Error("writing the extension " + axis.key + " (" + cfitsio_reason(status) + ")");
   }
   fitsfile* f = fits.f;
   fits.f = nullptr;

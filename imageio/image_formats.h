@@ -17,6 +17,11 @@ void write_hdf5(const Image& image, const ImageMetadata& metadata, const std::st
 void write_fits(const Image& image, const ImageMetadata& metadata, const std::string& file);
 void write_exr(const Image& image, const ImageMetadata& metadata, const std::string& file);
 void write_png(const Image& image, const ImageMetadata& metadata, const std::string& file);
+// Cubes (write_cube): the images one after another, first axis slowest.
+void write_hdf5_cube(const std::vector<const Image*>& images, const std::vector<CubeAxis>& axes,
+                     const ImageMetadata& metadata, const std::string& file);
+void write_fits_cube(const std::vector<const Image*>& images, const std::vector<CubeAxis>& axes,
+                     const ImageMetadata& metadata, const std::string& file);
 
 // Readers get an existing regular file and throw Error starting "PATH: ".
 // read_image then checks the band names and that every pixel is finite.

@@ -254,6 +254,47 @@ void write_image(const Image& image, const std::string& path, const ImageMetadat
   temporary.publish();
 }
 
+void write_cube(const std::vector<Image>& images, const std::vector<CubeAxis>& axes, const std::string& path,
+                const ImageMetadata& metadata, bool overwrite) {
+  check_image_format(path);
+  Format format{};
+  format_of(path, format);
+  if (format != Format::Fits && format != Format::Hdf5)
+    throw Error("cannot write " + path + ": a cube is written as .fits, .fit or .h5");
+  size_t points = 1;
+  for (const CubeAxis& a : axes) {
+    if (a.values.empty()) throw Error("cannot write " + path + ": the axis " + a.key + " has no values");
+    points *= a.values.size();
+  }
+  if (images.empty() || images.size() != points)
+    throw Error("cannot write " + path + ": " + std::to_string(images.size()) + " images for " +
+                std::to_string(points) + " grid points");
+  for (const Image& image : images) {
+    if (image.width != images.front().width || image.height != images.front().height ||
+        image.bands != images.front().bands)
+      throw Error("cannot write " + path + ": the cube's images differ in size or bands");
+    check_image(image, path, format);
+  }
+  if (double(images.front().pixels.size()) * double(images.size()) > double(kMaxElements))
+    throw Error("cannot write " + path + ": the cube holds more than 2^29 values (the readers' limit)");
+  check_metadata(metadata, path);
+  check_output_target(path, overwrite, "folder", true);
+  std::vector<const Image*> list;
+  for (const Image& image : images) list.push_back(&image);
+  TemporaryFile temporary(path);
+  try {
+    if (format == Format::Fits)
+      write_fits_cube(list, axes, metadata, temporary.path());
+    else
+      write_hdf5_cube(list, axes, metadata, temporary.path());
+  } catch (const Error& e) {
+    throw Error("cannot write " + path + ": " + e.what());
+  } catch (const std::bad_alloc&) {
+    throw Error("cannot write " + path + ": out of memory");
+  }
+  temporary.publish();
+}
+
 Image read_image(const std::string& path, ImageMetadata* metadata) {
   Format format{};
   if (!format_of(path, format))

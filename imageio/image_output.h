@@ -73,6 +73,23 @@ struct ImageMetadata {
 void write_image(const Image& image, const std::string& path, const ImageMetadata& metadata,
                  bool overwrite);
 
+// A cube of images over a grid of parameters (`nebula sweep`): one image per
+// grid point, all of one size and bands, the first axis varying slowest.
+struct CubeAxis {
+  std::string key;             // e.g. "dust.albedo"
+  std::vector<double> values;  // along the axis
+};
+
+// Writes the cube to PATH, .fits/.fit or .h5, with write_image's checks and
+// atomic replacement. FITS: NAXIS = 3 + K, NAXIS1..3 the image's width,
+// height and bands, then the axes last to first (numpy's shape: (first axis,
+// ..., bands, rows, columns)), and one 1-D extension per axis named by its
+// key holding its values. HDF5: /image of shape (axes..., bands, rows,
+// columns), /axes/<key> the values, root attribute "axes" the keys in order.
+// The metadata is the whole cube's (what all points share).
+void write_cube(const std::vector<Image>& images, const std::vector<CubeAxis>& axes, const std::string& path,
+                const ImageMetadata& metadata, bool overwrite);
+
 // write_image's first check, for callers that refuse a path before any work:
 // an unknown extension, or .exr/.png in a build without OpenImageIO.
 void check_image_format(const std::string& path);

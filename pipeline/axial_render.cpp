@@ -121,7 +121,7 @@ RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
   report.table_clamps = stats.table_clamps;
   out.metadata = scene_metadata(scene, sb, scene.camera, report.mode);
   out.metadata.entries.push_back({"multiple_scattering", multiple_scattering_text(report)});
-  out.metadata.entries.push_back({"samples_per_pixel", scene.samples_per_pixel});
+  out.metadata.entries.push_back({"pixel_samples", scene.samples_per_pixel});
   return out;
 }
 

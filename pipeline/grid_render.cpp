@@ -154,6 +154,8 @@ RenderOutput render_prepared(const PreparedGrid& p, const CameraSettings& settin
   const Camera camera = make_camera(settings);
   const int k = samples_per_pixel_side(scene.samples_per_pixel);
   RenderInputs in = p.inputs;
+  // The field is a member: a moved PreparedGrid's inputs still point at the old one's.
+  if (in.diffuse) in.diffuse = &p.diffuse;
   in.camera = make_camera(supersampled_camera(settings, scene.samples_per_pixel));
   in.exposure = 1.0f;  // science pixels: the exposure goes in the metadata
   std::unique_ptr<Progress> bar;
@@ -177,7 +179,7 @@ RenderOutput render_prepared(const PreparedGrid& p, const CameraSettings& settin
   draw_scene_stars(scene, p.bands, camera, 1.0, out.image);
   out.metadata = scene_metadata(scene, p.bands, settings, p.report.mode);
   out.metadata.entries.push_back({"pyramid_levels", scene.pyramid_levels});
-  out.metadata.entries.push_back({"samples_per_pixel", scene.samples_per_pixel});
+  out.metadata.entries.push_back({"pixel_samples", scene.samples_per_pixel});
   out.metadata.entries.push_back({"multiple_scattering", multiple_scattering_text(out.report)});
   return out;
 }

@@ -239,7 +239,7 @@ TEST_F(RenderScene, ABandsTableFileChangesThatBandOnly) {
 // dust (A/A_V = 1, V's albedo and g), so the image is V's scaled by L / L_V,
 // the diffuse field included (its photons carry the star's power linearly).
 TEST_F(RenderScene, TheGreyBandIsVWithTheWholeLuminosity) {
-  Scene v = scene("", "albedo = 0.6\ng = 0.6\n");
+  Scene v = scene("[render]\ndiffuse_photons = 65536\n", "albedo = 0.6\ng = 0.6\n");
   v.bands = {"V"};
   v.dust.albedo = {0.6};
   v.dust.g = {0.6};

@@ -102,7 +102,7 @@ TruthRenderOutput truth_scene(const Scene& scene, const TruthOptions& o) {
                            transmittance + " transmittance" + (o.equiangular ? " equiangular" : "") +
                            (o.max_orders ? " orders<=" + std::to_string(o.max_orders) : "") + traced;
   out.metadata = scene_metadata(scene, sb, scene.camera, mode);
-  out.metadata.entries.push_back({"samples_per_pixel", scene.samples_per_pixel});
+  out.metadata.entries.push_back({"pixel_samples", scene.samples_per_pixel});
   out.variance_metadata = out.metadata;
   out.variance_metadata.units = kRadianceVarianceUnit;  // of the pixel mean
   RunReport& r = out.report;
