@@ -43,6 +43,7 @@ void print_multiple_scattering(const RunReport& r) {
                 "on %dx%dx%d cells of %d voxel(s); %.3g s (photon passes %.3g s); noise, relative L2 of its l = 0 part:",
                 d.bands, (unsigned long long)d.photons_per_band, d.order, d.cells.nx, d.cells.ny, d.cells.nz,
                 d.voxels_per_cell, d.wall_seconds, d.seconds);
+    if (d.reused) std::printf(" [reused: nothing it depends on changed; figures of its bake]");
   }
   if (d.done) {
     for (size_t b = 0; b < d.noise.size() && b < r.bands.size(); ++b)
@@ -75,7 +76,10 @@ void print_computed(const RunReport& r) {
                 to_string(t.origin), t.path.c_str(), t.seconds);
   }
   if (r.truth) return;
-  if (r.bake.done)
+  if (r.bake.done && r.bake.reused)
+    std::printf("  bake: %zu star(s) x %llu voxels, reused (the grid and the stars' positions unchanged)\n",
+                r.bake.stars, (unsigned long long)r.bake.cells);
+  else if (r.bake.done)
     std::printf("  bake: %zu star(s)%s x %llu %s, %g s\n", r.bake.stars, r.axial ? " on the axis" : "",
                 (unsigned long long)r.bake.cells, r.axial ? "texels" : "voxels", r.bake.seconds);
   else

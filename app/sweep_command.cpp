@@ -102,6 +102,9 @@ void run_sweep_command(const Options& o) {
   so.force = o.force;
   double points = 1;
   for (const CubeAxis& a : axes) points *= double(a.values.size());
+  if (points > double(kMaxSweepPoints) && !o.force)
+    throw Error("--grid: " + to_text(points) + " points, more than " + std::to_string(kMaxSweepPoints) +
+                "; --force runs them anyway");
   std::unique_ptr<Progress> bar;
   size_t done = 0;
   SweepResult r;
@@ -130,7 +133,6 @@ void run_sweep_command(const Options& o) {
     std::printf("  reused: star bakes %zu of %zu, diffuse fields %zu of %zu (the rest computed for their point)\n",
                 reused_bakes, bakes, reused_fields, fields);
   std::printf("wrote %s\n", o.out.c_str());
-  (void)points;
 }
 
 }  // namespace

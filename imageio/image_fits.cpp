@@ -433,4 +433,75 @@ Image read_fits(const std::string& path, ImageMetadata* metadata) {
   return image;
 }
 
+
+std::vector<Image> read_fits_cube_file(const std::string& path, std::vector<CubeAxis>* cube_axes) {
+  const std::lock_guard<std::mutex> lock(fits_mutex);
+  FitsFile fits;
+  int status = 0;
+  if (fits_open_diskfile(&fits.f, path.c_str(), READONLY, &status) != 0) {
+    fits.f = nullptr;
+    throw Error(path + ": cannot open as FITS (" + cfitsio_reason(status) + "); expected a nebula cube");
+  }
+  const Reader r(path, fits.f);
+  int bitpix = 0, naxis = 0;
+  long axes[9] = {0};
+  if (fits_get_img_param(fits.f, 9, &bitpix, &naxis, axes, &status) != 0)
+    fail(path, "primary HDU", "an image", cfitsio_reason(status));
+  if (naxis < 3 || naxis > 9) fail(path, "NAXIS", "3 to 9 (width, height, bands, the cube's axes)", std::to_string(naxis));
+  size_t count = 1;
+  for (int k = 0; k < naxis; ++k) {
+    if (axes[k] <= 0 || size_t(axes[k]) > kMaxElements / count)
+      fail(path, "NAXIS" + std::to_string(k + 1), "a cube of 1 to 2^29 values", std::to_string(axes[k]));
+    count *= size_t(axes[k]);
+  }
+  int data_ok = 0, header_ok = 0;
+  if (fits_verify_chksum(fits.f, &data_ok, &header_ok, &status) != 0 || data_ok < 0 || header_ok < 0)
+    fail(path, "CHECKSUM", "matching checksums", "a mismatch (damaged file?)");
+  Image shape;
+  shape.width = static_cast<int>(axes[0]);
+  shape.height = static_cast<int>(axes[1]);
+  for (long b = 1; b <= axes[2]; ++b) shape.bands.push_back(r.string_key("BAND" + std::to_string(b), "a band name"));
+  std::vector<float> all(count);
+  int any_null = 0;
+  float no_null = 0;
+  if (fits_read_img(fits.f, TFLOAT, 1, static_cast<LONGLONG>(count), &no_null, all.data(), &any_null, &status) != 0)
+    fail(path, "data", "readable pixels", cfitsio_reason(status));
+  const size_t width = shape.width, plane = size_t(shape.width) * shape.height, per_image = plane * shape.bands.size();
+  std::vector<Image> images(count / per_image, shape);
+  for (size_t i = 0; i < images.size(); ++i) {
+    images[i].pixels.resize(per_image);
+    for (size_t b = 0; b < shape.bands.size(); ++b)
+      for (int y = 0; y < shape.height; ++y) {  // FITS rows go up
+        const float* row = &all[i * per_image + b * plane + size_t(shape.height - 1 - y) * width];
+        std::copy(row, row + width, images[i].pixels.begin() + b * plane + size_t(y) * width);
+      }
+  }
+  if (cube_axes) {
+    cube_axes->clear();
+    for (int k = naxis; k > 3; --k) {  // the first axis is the last FITS axis
+      cube_axes->push_back({r.string_key("SWEEP" + std::to_string(k), "the axis's key"), {}});
+      cube_axes->back().values.resize(size_t(axes[k - 1]));
+    }
+    int hdus = 0;
+    if (fits_get_num_hdus(fits.f, &hdus, &status) != 0) fail(path, "HDUs", "a readable file", cfitsio_reason(status));
+    for (int h = 2; h <= hdus; ++h) {
+      if (fits_movabs_hdu(fits.f, h, nullptr, &status) != 0)
+        fail(path, "HDU " + std::to_string(h), "a readable extension", cfitsio_reason(status));
+      long number = 0;
+      if (fits_read_key_lng(fits.f, "AXISNUM", &number, nullptr, &status) != 0) {
+        status = 0;
+        fits_clear_errmsg();
+        continue;
+      }
+      if (number < 4 || number > naxis) fail(path, "AXISNUM", "4 to NAXIS", std::to_string(number));
+      std::vector<double>& values = (*cube_axes)[size_t(naxis - number)].values;
+      double none = 0;
+      if (fits_read_img(fits.f, TDOUBLE, 1, static_cast<LONGLONG>(values.size()), &none, values.data(), &any_null,
+                        &status) != 0)
+        fail(path, "AXIS" + std::to_string(number), "the axis's values", cfitsio_reason(status));
+    }
+  }
+  return images;
+}
+
 }  // namespace nebula::imageio_detail

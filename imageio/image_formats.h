@@ -28,6 +28,7 @@ void write_fits_cube(const std::vector<const Image*>& images, const std::vector<
 Image read_hdf5(const std::string& path, ImageMetadata* metadata);
 Image read_fits(const std::string& path, ImageMetadata* metadata);
 Image read_exr(const std::string& path, ImageMetadata* metadata);
+std::vector<Image> read_fits_cube_file(const std::string& path, std::vector<CubeAxis>* axes);
 
 // The most floats a reader allocates (2 GiB): a malformed header claiming
 // more is refused instead of exhausting memory.

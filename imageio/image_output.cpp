@@ -295,6 +295,12 @@ void write_cube(const std::vector<Image>& images, const std::vector<CubeAxis>& a
   temporary.publish();
 }
 
+std::vector<Image> read_fits_cube(const std::string& path, std::vector<CubeAxis>* axes) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) throw Error(path + ": cannot read: no such file");
+  return read_fits_cube_file(path, axes);
+}
+
 Image read_image(const std::string& path, ImageMetadata* metadata) {
   Format format{};
   if (!format_of(path, format))

@@ -90,6 +90,10 @@ struct CubeAxis {
 void write_cube(const std::vector<Image>& images, const std::vector<CubeAxis>& axes, const std::string& path,
                 const ImageMetadata& metadata, bool overwrite);
 
+// Reads a FITS cube written by write_cube: the images, first axis slowest,
+// and the axes with their values. Errors name the file and the field.
+std::vector<Image> read_fits_cube(const std::string& path, std::vector<CubeAxis>* axes = nullptr);
+
 // write_image's first check, for callers that refuse a path before any work:
 // an unknown extension, or .exr/.png in a build without OpenImageIO.
 void check_image_format(const std::string& path);

@@ -125,6 +125,55 @@ TEST_F(ImageFile, Hdf5RoundTripIsExact) {
   EXPECT_EQ(files(), std::vector<std::string>{"a.h5"});  // no temporary left
 }
 
+// A 3 x 2 cube: each point's image distinct (scaled), read back point by
+// point with its axes; HDF5 with /image of shape (3, 2, bands, rows, columns)
+// and the axes' values.
+TEST_F(ImageFile, CubesRoundTripWithTheirAxes) {
+  std::vector<Image> images;
+  for (int k = 0; k < 6; ++k) {
+    Image image = make_image(7, 5);
+    for (float& v : image.pixels) v = v * float(k + 1) + float(k);
+    images.push_back(image);
+  }
+  const std::vector<CubeAxis> axes{{"dust.albedo", {0.3, 0.6, 0.9}}, {"dust.g", {0.0, 0.75}}};
+  write_cube(images, axes, path("c.fits"), make_metadata(), false);
+  std::vector<CubeAxis> read_axes;
+  const std::vector<Image> back = read_fits_cube(path("c.fits"), &read_axes);
+  ASSERT_EQ(back.size(), 6u);
+  for (int k = 0; k < 6; ++k) expect_same_bits(images[k], back[k]);
+  ASSERT_EQ(read_axes.size(), 2u);
+  for (int a = 0; a < 2; ++a) {
+    EXPECT_EQ(read_axes[a].key, axes[a].key);
+    EXPECT_EQ(read_axes[a].values, axes[a].values);
+  }
+  write_cube(images, axes, path("c.h5"), make_metadata(), false);
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  const hid_t file = H5Fopen(path("c.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  const hid_t set = H5Dopen2(file, "/image", H5P_DEFAULT);
+  const hid_t space = H5Dget_space(set);
+  hsize_t dims[5] = {0};
+  ASSERT_EQ(H5Sget_simple_extent_ndims(space), 5);
+  H5Sget_simple_extent_dims(space, dims, nullptr);
+  EXPECT_EQ((std::vector<hsize_t>(dims, dims + 5)), (std::vector<hsize_t>{3, 2, 3, 5, 7}));
+  std::vector<float> all(3 * 2 * 3 * 5 * 7);
+  ASSERT_GE(H5Dread(set, H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, all.data()), 0);
+  EXPECT_EQ(std::vector<float>(all.begin() + 5 * 105, all.begin() + 6 * 105), images[5].pixels);
+  const hid_t g = H5Dopen2(file, "/axes/dust.g", H5P_DEFAULT);
+  double values[2] = {0, 0};
+  ASSERT_GE(H5Dread(g, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values), 0);
+  EXPECT_EQ(values[1], 0.75);
+  H5Dclose(g);
+  H5Sclose(space);
+  H5Dclose(set);
+  H5Fclose(file);
+  // Refusals: too few images, an empty axis, a PNG.
+  EXPECT_THROW(write_cube({images[0]}, axes, path("d.fits"), make_metadata(), false), Error);
+  EXPECT_THROW(write_cube(images, {{"dust.g", {}}}, path("d.fits"), make_metadata(), false), Error);
+  EXPECT_THROW(write_cube(images, axes, path("d.png"), make_metadata(), false), Error);
+  EXPECT_FALSE(std::filesystem::exists(path("d.fits")));
+}
+
 TEST_F(ImageFile, Hdf5LayoutAsDocumented) {
   const Image image = make_image(7, 5);
   write_image(image, path("a.h5"), make_metadata(), false);
