@@ -478,8 +478,8 @@ std::vector<Image> read_fits_cube_file(const std::string& path, std::vector<Cube
   }
   if (cube_axes) {
     cube_axes->clear();
-    for (int k = naxis; k > 3; --k) {  // the first axis is the last FITS axis
-      cube_axes->push_back({r.string_key("SWEEP" + std::to_string(k), "the axis's key"), {}});
+    for (int k = naxis; k > 3; --k) {  // the first axis is the last FITS axis; keys from the extensions
+      cube_axes->push_back({"", {}});
       cube_axes->back().values.resize(size_t(axes[k - 1]));
     }
     int hdus = 0;
@@ -494,13 +494,21 @@ std::vector<Image> read_fits_cube_file(const std::string& path, std::vector<Cube
         continue;
       }
       if (number < 4 || number > naxis) fail(path, "AXISNUM", "4 to NAXIS", std::to_string(number));
-      std::vector<double>& values = (*cube_axes)[size_t(naxis - number)].values;
+      CubeAxis& axis = (*cube_axes)[size_t(naxis - number)];
+      char extname[FLEN_VALUE] = {0};
+      if (fits_read_key_str(fits.f, "EXTNAME", extname, nullptr, &status) != 0)
+        fail(path, "EXTNAME", "the key of axis " + std::to_string(number), cfitsio_reason(status));
+      axis.key = extname;
+      std::vector<double>& values = axis.values;
       double none = 0;
       if (fits_read_img(fits.f, TDOUBLE, 1, static_cast<LONGLONG>(values.size()), &none, values.data(), &any_null,
                         &status) != 0)
         fail(path, "AXIS" + std::to_string(number), "the axis's values", cfitsio_reason(status));
     }
   }
+  if (cube_axes)
+    for (const CubeAxis& a : *cube_axes)
+      if (a.key.empty()) fail(path, "extensions", "one per cube axis (AXISNUM, EXTNAME)", "an axis without one");
   return images;
 }
 
