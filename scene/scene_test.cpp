@@ -331,7 +331,7 @@ TEST_F(SceneFile, RefusesBadDust) {
   refused("rv_low", edited("R_V = 5.0", "R_V = 1.5"), {"dust.R_V", "[2, 6]"});
   refused("rv_high", edited("R_V = 5.0", "R_V = 6.5"), {"dust.R_V", "[2, 6]"});
   refused("law", edited("R_V = 5.0", "law = \"fitzpatrick99\""), {"dust.law", "fitzpatrick99"});
-  refused("bands", std::string("bands = [\"B\", \"U\"]\n") + kBase, {"bands", "'U'"});
+  refused("bands", std::string("bands = [\"B\", \"X\"]\n") + kBase, {"bands", "'X'"});
   refused("bands_twice", std::string("bands = [\"B\", \"B\"]\n") + kBase, {"bands", "twice"});
 }
 

@@ -1,0 +1,91 @@
+#include "spectral/two_column_file.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+#include "spectral/spectra.h"
+
+namespace nebula::spectral {
+namespace {
+[[noreturn]] void refuse(const std::string& path, int line, const std::string& reason) {
+  throw Error(path + ":" + std::to_string(line) + ": " + reason);
+}
+}  // namespace
+
+TwoColumns read_two_columns(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot open (missing or unreadable)");
+  TwoColumns out;
+  std::string text;
+  bool any = false;
+  for (int line = 1; std::getline(in, text); ++line) {
+    const size_t hash = text.find('#');
+    if (hash != std::string::npos) text.resize(hash);
+    for (char& c : text)
+      if (c == ',' || c == '\t' || c == '\r') c = ' ';
+    std::istringstream cells(text);
+    std::string a, b, extra;
+    if (!(cells >> a)) continue;
+    if (!(cells >> b) || (cells >> extra)) refuse(path, line, "expected two columns (wavelength_nm value)");
+    char* end = nullptr;
+    const double x = std::strtod(a.c_str(), &end);
+    if (*end != '\0' || !std::isfinite(x)) refuse(path, line, "wavelength '" + a + "' is not a finite number");
+    const double y = std::strtod(b.c_str(), &end);
+    if (*end != '\0' || !std::isfinite(y)) refuse(path, line, "value '" + b + "' is not a finite number");
+    if (!(x > 0.0)) refuse(path, line, "wavelength " + a + " nm is not positive");
+    if (!out.x.empty() && !(x > out.x.back()))
+      refuse(path, line, "wavelengths must be strictly ascending (" + a + " nm after " + to_text(out.x.back()) + ")");
+    if (y < 0.0) refuse(path, line, "value " + b + " is negative");
+    any = any || y > 0.0;
+    out.x.push_back(x);
+    out.y.push_back(y);
+  }
+  if (out.x.size() < 2) throw Error(path + ": needs at least 2 rows, found " + std::to_string(out.x.size()));
+  if (!any) throw Error(path + ": every value is zero");
+  return out;
+}
+
+Passband load_filter_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot open filter file (missing or unreadable)");
+  std::string text;
+  while (std::getline(in, text)) {
+    if (text.empty() || text[0] == '#') continue;
+    if (text.rfind("wavelength_", 0) == 0) return load_passband(path);  // the data/filters CSV
+    break;
+  }
+  const TwoColumns c = read_two_columns(path);
+  Passband p;
+  p.name = std::filesystem::path(path).stem().string();
+  p.wavelength_nm = c.x;
+  p.response = c.y;
+  return p;
+}
+
+double TabulatedSpectrum::operator()(double lambda) const {
+  if (wavelength_um.empty() || lambda < wavelength_um.front() || lambda > wavelength_um.back()) return 0.0;
+  size_t i = 1;
+  while (i + 1 < wavelength_um.size() && wavelength_um[i] < lambda) ++i;
+  const double u = (lambda - wavelength_um[i - 1]) / (wavelength_um[i] - wavelength_um[i - 1]);
+  return (1 - u) * shape[i - 1] + u * shape[i];
+}
+
+TabulatedSpectrum load_spectrum(const std::string& path) {
+  const TwoColumns c = read_two_columns(path);
+  TabulatedSpectrum s;
+  s.name = std::filesystem::path(path).stem().string();
+  double integral = 0.0;
+  for (size_t i = 0; i < c.x.size(); ++i) {
+    s.wavelength_um.push_back(c.x[i] / 1000.0);
+    s.shape.push_back(c.y[i]);
+    if (i > 0) integral += 0.5 * (c.y[i] + c.y[i - 1]) * (c.x[i] - c.x[i - 1]) / 1000.0;
+  }
+  for (double& v : s.shape) v /= integral;
+  return s;
+}
+
+}  // namespace nebula::spectral
