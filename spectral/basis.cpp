@@ -73,4 +73,53 @@ std::vector<double> project(const WavelengthGrid& grid, const GreedyBasis& basis
   return c;
 }
 
+std::vector<double> project_relative(const WavelengthGrid& grid, const GreedyBasis& basis,
+                                     const std::vector<double>& f) {
+  const size_t G = f.size(), N = basis.phi.size();
+  double peak = 0.0;
+  for (double v : f) peak = std::max(peak, std::fabs(v));
+  if (!(peak > 0.0)) return std::vector<double>(N, 0.0);
+  // Rows sqrt(w_i) phi_j(i) / f_i, right-hand side sqrt(w_i): the residual of row i
+  // is sqrt(w_i) (f_i - sum c_j phi_j(i)) / f_i.
+  std::vector<std::vector<double>> a(N, std::vector<double>(G));  // columns
+  std::vector<double> b(G);
+  for (size_t i = 0; i < G; ++i) {
+    const double fi = std::max(std::fabs(f[i]), 1e-200 * peak);
+    const double s = std::sqrt(grid.weight[i]) / fi;
+    for (size_t j = 0; j < N; ++j) a[j][i] = basis.phi[j][i] * s;
+    b[i] = std::sqrt(grid.weight[i]) * (f[i] >= 0.0 ? 1.0 : -1.0);
+  }
+  // Householder QR, column by column; b transformed alongside.
+  std::vector<double> diag(N);
+  for (size_t k = 0; k < N; ++k) {
+    double norm = 0.0;
+    for (size_t i = k; i < G; ++i) norm += a[k][i] * a[k][i];
+    norm = std::sqrt(norm);
+    const double alpha = a[k][k] > 0.0 ? -norm : norm;
+    diag[k] = alpha;
+    if (norm == 0.0) continue;
+    std::vector<double> v(a[k].begin() + std::ptrdiff_t(k), a[k].end());
+    v[0] -= alpha;
+    double vv = 0.0;
+    for (double x : v) vv += x * x;
+    if (vv == 0.0) continue;
+    const auto reflect = [&](std::vector<double>& col) {
+      double d = 0.0;
+      for (size_t i = k; i < G; ++i) d += v[i - k] * col[i];
+      d *= 2.0 / vv;
+      for (size_t i = k; i < G; ++i) col[i] -= d * v[i - k];
+    };
+    for (size_t j = k + 1; j < N; ++j) reflect(a[j]);
+    reflect(b);
+  }
+  // Back substitution on R c = Q^T b (a column with no length left gets 0).
+  std::vector<double> c(N, 0.0);
+  for (size_t k = N; k-- > 0;) {
+    double s = b[k];
+    for (size_t j = k + 1; j < N; ++j) s -= a[j][k] * c[j];
+    c[k] = std::fabs(diag[k]) > 1e-300 ? s / diag[k] : 0.0;
+  }
+  return c;
+}
+
 }  // namespace nebula::spectral

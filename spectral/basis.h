@@ -40,7 +40,19 @@ struct GreedyBasis {
 GreedyBasis greedy_basis(const WavelengthGrid& grid, const std::vector<std::vector<double>>& family, int n,
                          int first = 0);
 
-// Coefficients <f, phi_j> of f on the basis.
+// Coefficients <f, phi_j> of f on the basis (the orthogonal projection:
+// least absolute L2 error).
 std::vector<double> project(const WavelengthGrid& grid, const GreedyBasis& basis, const std::vector<double>& f);
+
+// Coefficients c of the least *relative* error: min integral ((f - sum c_j phi_j) / f)^2
+// d lambda, f > 0 on the grid (values below 1e-200 of its peak are floored there).
+// Where f spans decades (e^(-kappa D) at large D), the orthogonal projection
+// leaves a residual of the size of f's peak in the wavelengths where f is
+// small, a large relative error in every filter there; this one keeps the
+// error relative everywhere (docs/spectral.md, "Relative projection").
+// Householder QR on the weighted system (the weights span many decades: normal
+// equations would square their condition).
+std::vector<double> project_relative(const WavelengthGrid& grid, const GreedyBasis& basis,
+                                     const std::vector<double>& f);
 
 }  // namespace nebula::spectral

@@ -49,6 +49,10 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
   if (filters.empty()) throw Error("spectral: no filter");
   if (settings.basis < 1 || settings.basis > 16)
     throw Error("spectral: the basis size is " + std::to_string(settings.basis) + "; must be in 1..16");
+  if (!(settings.max_depth >= 0 && std::isfinite(settings.max_depth)))
+    throw Error("spectral: max_depth is " + to_text(settings.max_depth) + "; must be >= 0 (0: automatic)");
+  if (!(settings.fit_depth >= 0 && std::isfinite(settings.fit_depth)))
+    throw Error("spectral: fit_depth is " + to_text(settings.fit_depth) + "; must be >= 0 (0: automatic)");
   if (settings.wavelengths < 2)
     throw Error("spectral: wavelengths is " + std::to_string(settings.wavelengths) + "; must be at least 2");
   for (const SpectralStar& s : stars) {
@@ -96,6 +100,9 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
   }
   m.max_eye_depth = float(kTransmittanceCut / kappa_min);
   m.max_depth = settings.max_depth > 0 ? settings.max_depth : kTransmittanceCut / kappa_min;
+  m.fit_depth = settings.fit_depth > 0 ? settings.fit_depth : std::min(kFitDepth, m.max_depth);
+  if (!(m.fit_depth <= m.max_depth))
+    throw Error("spectral: fit_depth " + to_text(m.fit_depth) + " exceeds max_depth " + to_text(m.max_depth));
   const int F = int(filters.size()), S = int(stars.size()), N = settings.basis;
   std::vector<std::vector<double>> S_on_grid(F);
   for (int f = 0; f < F; ++f)
@@ -142,7 +149,7 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
       };
       for (int t = 0; t < family_temperatures; ++t)
         for (int d = 0; d < kFamilyDepths; ++d) {
-          const double a = m.max_depth * d / (kFamilyDepths - 1);
+          const double a = m.fit_depth * d / (kFamilyDepths - 1);
           const double T = temperature_at(t, family_temperatures);
           // Light-density members: the star's shape scaled to unit norm on the grid, so
           // that hot and cool stars weigh alike; attenuation keeps its absolute weight.
@@ -154,9 +161,17 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
           }
           std::vector<double> f;
           for (size_t i = 0; i < m.grid.lambda.size(); ++i) f.push_back(shape[i] * std::exp(-m.kappa_grid[i] * a));
+          if (settings.relative) {
+            const double norm = m.grid.norm(f);
+            for (double& v : f) v /= norm;
+          }
           family.push_back(std::move(f));
         }
       m.basis = greedy_basis(m.grid, family, N, 0);
+      for (int k : m.basis.chosen) {
+        m.element_depth.push_back(m.fit_depth * (k % kFamilyDepths) / (kFamilyDepths - 1));
+        if (light) m.element_temperature_K.push_back(temperature_at(k / kFamilyDepths, family_temperatures));
+      }
       const int n = m.basis.size();  // may stop short when the family is exhausted
       m.settings.basis = n;
       m.n_temperature = light ? settings.temperature_nodes : 1;
@@ -172,7 +187,8 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
         for (int d = 0; d < D; ++d) {
           for (size_t i = 0; i < f.size(); ++i)
             f[i] = (light ? planck_shape(m.grid.lambda[i], T) : 1.0) * std::exp(-m.kappa_grid[i] * d * m.depth_step);
-          for (double c : project(m.grid, m.basis, f)) m.coeff.push_back(float(c));
+          for (double c : settings.relative ? project_relative(m.grid, m.basis, f) : project(m.grid, m.basis, f))
+            m.coeff.push_back(float(c));
         }
       }
       for (const SpectralStar& s : stars) {

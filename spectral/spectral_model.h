@@ -21,6 +21,9 @@ namespace nebula::spectral {
 // the V filter is 1 (tau_V is the V-band depth, DESIGN.md section 3).
 enum class Attenuation { Inverse, Law };
 
+// The default family range: V-band optical paths up to 8 (transmission 3e-4).
+constexpr double kFitDepth = 8.0;
+
 struct SpectralSettings {
   SpectralMethod method = SpectralMethod::Projection;
   int basis = 4;            // elements of the greedy basis (Projection, LightBasis), 1..16
@@ -28,9 +31,21 @@ struct SpectralSettings {
   Attenuation attenuation = Attenuation::Inverse;
   double R_V = 5.0;
   ExtinctionLaw law = ExtinctionLaw::CCM89;
-  // The family's optical paths a in [0, max_depth] (V band); 0: where the
-  // longest wavelength is attenuated to the marcher's cut, e^(-kappa_min a) = 1e-4.
+  // The coefficient table's optical paths D in [0, max_depth] (V band); a pair
+  // past it is dropped. 0: where the longest wavelength is attenuated to the
+  // marcher's cut, e^(-kappa_min D) = 1e-4.
   double max_depth = 0;
+  // The basis family's optical paths a in [0, fit_depth] (V band), where the
+  // basis is chosen to be accurate; past it the error grows (bounded by the
+  // relative projection). 0: the default kFitDepth.
+  double fit_depth = 0;
+  // The error measure of the greedy and the coefficients. Relative (ours): each
+  // member scaled to unit norm for the greedy, coefficients of least relative
+  // error (project_relative). Absolute (the report's): members as they are,
+  // orthogonal projection; its error is absolute, so light that arrives through
+  // long optical paths (dim, but all a pixel behind dense dust receives) is
+  // poorly represented (docs/spectral.md).
+  bool relative = true;
   int depth_nodes = 2048;       // coefficient table over a
   int temperature_nodes = 48;   // LightBasis: table over log T in [2000, 60000] K
   int grid_nodes = 1024;        // wavelength grid of the inner products
@@ -56,7 +71,10 @@ struct SpectralModel {
   WavelengthGrid grid;
   std::vector<double> kappa_grid;  // kappa on the grid
   GreedyBasis basis;
-  double max_depth = 0;
+  // The chosen members: their optical path a (V band) and, for the
+  // light-density basis, their star temperature (K).
+  std::vector<double> element_depth, element_temperature_K;
+  double max_depth = 0, fit_depth = 0;
   int n_stars = 0;
   std::vector<SpectralStar> stars;
   // Arrays of the view (host copies).
