@@ -1,5 +1,7 @@
 #include "pipeline/scene_bands.h"
 
+#include <algorithm>
+
 #include "illumination/extinction.h"
 #include "illumination/filters.h"
 #include "illumination/star.h"
@@ -8,7 +10,11 @@ namespace nebula {
 
 SceneBands scene_bands(const Scene& scene) {
   SceneBands out;
-  for (const std::string& name : scene.bands) out.filters.push_back(load_filter(name));
+  for (const std::string& name : scene.bands) {
+    const auto own = std::find_if(scene.filters.begin(), scene.filters.end(),
+                                  [&](const SceneFilter& f) { return f.name == name; });
+    out.filters.push_back(own != scene.filters.end() ? own->passband : load_filter(name));
+  }
   const std::vector<double> ratios =
       extinction_ratios(out.filters, load_filter("V"), scene.dust.R_V, scene.dust.law);
   for (size_t b = 0; b < scene.bands.size(); ++b)
