@@ -395,6 +395,7 @@ void add_bench_command(CLI::App& app) {
   add_truth(cmd);
   add_axial(cmd);
   add_sweep(cmd);
+  add_spectral_bench(cmd);
 }
 
 }  // namespace nebula::app

@@ -9,6 +9,8 @@ void add_table_command(CLI::App& app);
 void add_slab_command(CLI::App& app);
 void add_validate_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_filters_command(CLI::App& app);
+void add_spectral_bench(CLI::App* bench);
 void add_render_command(CLI::App& app);
 void add_truth_command(CLI::App& app);
 void add_compare_command(CLI::App& app);

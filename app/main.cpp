@@ -69,6 +69,7 @@ int main(int argc, char** argv) {
   nebula::app::add_slab_command(app);
   nebula::app::add_validate_command(app);
   nebula::app::add_bench_command(app);
+  nebula::app::add_filters_command(app);
   if (unknown_command(app, argc, argv)) return 2;
   try {
     app.parse(argc, argv);

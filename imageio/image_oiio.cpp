@@ -134,16 +134,10 @@ void write_exr(const Image& image, const ImageMetadata& metadata, const std::str
 }
 
 void write_png(const Image& image, const ImageMetadata& metadata, const std::string& file_name) {
-  // Red, green, blue from R, V, B; one grey channel from a single band.
-  std::vector<int> source;
-  if (image.bands.size() == 1) {
-    source = {0};
-  } else {
-    for (const char* band : {"R", "V", "B"})
-      source.push_back(static_cast<int>(
-          std::find(image.bands.begin(), image.bands.end(), band) - image.bands.begin()));
-  }
-  const int channels = static_cast<int>(source.size());
+  // Grey from a single band, else red, green, blue as weighted sums of the
+  // bands (png_colours: R, V, B themselves, or hues by pivot wavelength).
+  const std::vector<PngColour> colours = png_colours(image, metadata);
+  const int channels = image.bands.size() == 1 ? 1 : 3;
   OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::UINT8);
   spec.attribute("oiio:ColorSpace", "sRGB");
   spec.attribute(kPrefix + kBandsName, join_bands(image.bands));
@@ -152,8 +146,14 @@ void write_png(const Image& image, const ImageMetadata& metadata, const std::str
   const size_t plane = image.plane_size();
   std::vector<uint8_t> levels(plane * channels);
   for (size_t i = 0; i < plane; ++i)
-    for (int c = 0; c < channels; ++c)
-      levels[i * channels + c] = srgb_level(image.pixels[source[c] * plane + i], metadata.exposure);
+    for (int c = 0; c < channels; ++c) {
+      float v = 0.0f;
+      for (size_t b = 0; b < colours.size(); ++b) {
+        const PngColour& w = colours[b];
+        v += (c == 0 ? w.red : c == 1 ? w.green : w.blue) * image.pixels[b * plane + i];
+      }
+      levels[i * channels + c] = srgb_level(v, metadata.exposure);
+    }
   write_with("png", spec, OIIO::TypeDesc::UINT8, levels.data(), file_name);
 }
 

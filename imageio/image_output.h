@@ -112,6 +112,19 @@ Image read_image(const std::string& path, ImageMetadata* metadata = nullptr);
 // deep or 3-D image, non-finite values.
 Image read_any_image(const std::string& path);
 
+// How a PNG shows an image's bands (docs/image_files.md, "PNG"): per band, the
+// weights of its plane in red, green and blue. One band: grey. Bands B, V, R:
+// red, green, blue from R, V, B. Otherwise every band needs a pivot wavelength
+// in the metadata (entry pivot_nm_<band>, as rendered images carry): the bands
+// ranked by pivot take hues from blue (the shortest) to red (the longest),
+// evenly by rank; with two bands, blue and red, and green their mean. Each
+// channel's weights sum to 1, so equal planes show grey. Error (one line, the
+// bands named) when neither rule applies.
+struct PngColour {
+  float red = 0, green = 0, blue = 0;
+};
+std::vector<PngColour> png_colours(const Image& image, const ImageMetadata& metadata);
+
 // Where the variance of an image lives (the ground truth writes one beside its
 // image; comparisons look for it): "out.h5" -> "out.var.h5".
 std::string variance_path(const std::string& image_path);

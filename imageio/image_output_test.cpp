@@ -442,6 +442,46 @@ TEST_F(ImageFile, PngNeedsBvrOrOneBand) {
   EXPECT_TRUE(files().empty());
 }
 
+// Bands other than B, V, R are coloured by their pivot wavelengths
+// (pivot_nm_<band>, or pivot_nm_b<plane> for long names): blue to red by rank,
+// each channel's weights summing to 1; B, V, R themselves are unchanged.
+TEST(PngColours, ByPivotWavelength) {
+  const auto near = [](const PngColour& c, float r, float g, float b) {
+    EXPECT_NEAR(c.red, r, 1e-6f);
+    EXPECT_NEAR(c.green, g, 1e-6f);
+    EXPECT_NEAR(c.blue, b, 1e-6f);
+  };
+  ImageMetadata m;
+  const std::vector<PngColour> bvr = png_colours(make_image(1, 1, {"V", "R", "B"}), m);
+  near(bvr[0], 0, 1, 0);
+  near(bvr[1], 1, 0, 0);
+  near(bvr[2], 0, 0, 1);
+  near(png_colours(make_image(1, 1, {"F606W"}), m)[0], 1, 1, 1);
+  // Three bands in any order: the shortest pivot blue, the middle green, the longest red.
+  m.entries = {{"pivot_nm_i", 760.0}, {"pivot_nm_b2", 470.0}, {"pivot_nm_r", 620.0}};
+  const std::vector<PngColour> gri = png_colours(make_image(1, 1, {"i", "sdss_g", "r"}), m);
+  near(gri[0], 1, 0, 0);
+  near(gri[1], 0, 0, 1);
+  near(gri[2], 0, 1, 0);
+  // Two: blue and red, green their mean.
+  m.entries = {{"pivot_nm_x", 500.0}, {"pivot_nm_y", 400.0}};
+  const std::vector<PngColour> two = png_colours(make_image(1, 1, {"x", "y"}), m);
+  near(two[0], 1, 0.5f, 0);
+  near(two[1], 0, 0.5f, 1);
+  // Five: hues 240, 180, 120, 60, 0 degrees; every channel sums to 1, so equal planes are grey.
+  m.entries = {{"pivot_nm_a", 1.0}, {"pivot_nm_c", 2.0}, {"pivot_nm_d", 3.0}, {"pivot_nm_e", 4.0}, {"pivot_nm_f", 5.0}};
+  const std::vector<PngColour> five = png_colours(make_image(1, 1, {"a", "c", "d", "e", "f"}), m);
+  float sum[3] = {0, 0, 0};
+  for (const PngColour& c : five) {
+    sum[0] += c.red;
+    sum[1] += c.green;
+    sum[2] += c.blue;
+  }
+  for (float v : sum) EXPECT_NEAR(v, 1.0f, 1e-6f);
+  near(five[1], 0, 1.0f / 3, 0.5f);  // cyan: green and blue
+  expect_error([&] { png_colours(make_image(1, 1, {"a", "g"}), m); }, {"pivot", "band g"});
+}
+
 TEST(ToneMap, CurveAndLevels) {
   EXPECT_DOUBLE_EQ(srgb_encode(0.0), 0.0);
   EXPECT_DOUBLE_EQ(srgb_encode(1.0), 1.0);

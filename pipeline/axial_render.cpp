@@ -130,7 +130,9 @@ RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
 RenderOutput render_scene(const Scene& scene, const RenderOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   RenderOutput out =
-      scene.axial ? render_axial_scene(scene, options) : render_prepared(prepare_grid(scene, options), scene.camera);
+      scene.spectral ? render_spectral_scene(scene, options)
+      : scene.axial  ? render_axial_scene(scene, options)
+                     : render_prepared(prepare_grid(scene, options), scene.camera);
   out.report.total_seconds = seconds_since(start);
   return out;
 }

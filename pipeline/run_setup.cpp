@@ -33,6 +33,10 @@ RunReport begin_report(const Scene& scene, const SceneBands& bands, const std::s
   return r;
 }
 
+std::string band_key(const std::vector<std::string>& bands, size_t b) {
+  return bands[b].size() <= kBandKeyLength ? bands[b] : "b" + std::to_string(b + 1);
+}
+
 double pivot_wavelength_nm(const Passband& p) {
   const double up = passband_integral(p, [](double l) { return l; }, kPassbandSubdivisions);
   const double down = passband_integral(p, [](double l) { return 1.0 / l; }, kPassbandSubdivisions);
@@ -107,8 +111,9 @@ ImageMetadata scene_metadata(const Scene& scene, const SceneBands& bands, const 
   meta.entries.push_back({"scene", scene.path});
   meta.entries.push_back({"mode", mode});
   for (size_t b = 0; b < scene.bands.size(); ++b) {
-    const std::string& name = scene.bands[b];
-    if (b < bands.filters.size() && !bands.filters[b].wavelength_nm.empty()) meta.entries.push_back({"pivot_nm_" + name, pivot_wavelength_nm(bands.filters[b])});
+    const std::string name = band_key(scene.bands, b);
+    if (b < bands.filters.size() && !bands.filters[b].wavelength_nm.empty())
+      meta.entries.push_back({"pivot_nm_" + name, pivot_wavelength_nm(bands.filters[b])});
     meta.entries.push_back({"albedo_" + name, scene.dust.albedo[b]});
     meta.entries.push_back({"g_" + name, scene.dust.g[b]});
     meta.entries.push_back({"ext_" + name, double(bands.bands[b].extinction_ratio)});
@@ -137,7 +142,7 @@ ImageMetadata scene_metadata(const Scene& scene, const SceneBands& bands, const 
     meta.entries.push_back({s + "L_Lsun", star.luminosity_lsun});
     if (k < bands.stars.size())
       for (size_t b = 0; b < scene.bands.size() && b < bands.stars[k].power.size(); ++b)
-        meta.entries.push_back({s + "P_" + scene.bands[b], double(bands.stars[k].power[b])});
+        meta.entries.push_back({s + "P_" + band_key(scene.bands, b), double(bands.stars[k].power[b])});
   }
   meta.scene_text = scene.resolved_toml;
   return meta;

@@ -39,6 +39,13 @@ inline const char* const kRadianceVarianceUnit = "solLum2 pc-4 sr-2";
 // for the orthographic camera, angles from the view axis (TAN, ARC) for the
 // perspective and fisheye cameras (docs/image_files.md).
 MetaEntries camera_wcs(const CameraSettings& camera);
+// A band as per-band metadata keys name it (pivot_nm_<key>, albedo_<key>,
+// star1_P_<key>, ...): its name when at most kBandKeyLength characters, else
+// "b" and its plane number from 1 ("b2"): numeric keys have at most 14
+// characters (imageio/image_output.h), and "pivot_nm_" takes 9 of them.
+constexpr size_t kBandKeyLength = 5;
+std::string band_key(const std::vector<std::string>& bands, size_t b);
+
 // sqrt(integral T lambda / integral T / lambda), nm.
 double pivot_wavelength_nm(const Passband& passband);
 

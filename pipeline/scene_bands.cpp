@@ -1,5 +1,7 @@
 #include "pipeline/scene_bands.h"
 
+#include <algorithm>
+
 #include "illumination/extinction.h"
 #include "illumination/filters.h"
 #include "illumination/star.h"
@@ -11,8 +13,13 @@ bool is_grey_band(const std::string& name) { return name == kGreyBand; }
 SceneBands scene_bands(const Scene& scene) {
   SceneBands out;
   // The grey band has no filter: an empty passband named "grey" holds its place.
-  for (const std::string& name : scene.bands)
-    out.filters.push_back(is_grey_band(name) ? Passband{kGreyBand, {}, {}} : load_filter(name));
+  for (const std::string& name : scene.bands) {
+    const auto own = std::find_if(scene.filters.begin(), scene.filters.end(),
+                                  [&](const SceneFilter& f) { return f.name == name; });
+    out.filters.push_back(own != scene.filters.end() ? own->passband
+                          : is_grey_band(name)       ? Passband{kGreyBand, {}, {}}
+                                                     : load_filter(name));
+  }
   const Passband V = load_filter("V");
   for (size_t b = 0; b < scene.bands.size(); ++b) {
     const double ratio = is_grey_band(scene.bands[b])

@@ -16,6 +16,7 @@
 #include "core/grid.h"
 #include "core/vec3.h"
 #include "illumination/extinction.h"
+#include "illumination/passband.h"
 
 namespace nebula {
 
@@ -86,6 +87,30 @@ struct DiffuseSettings {
   uint64_t seed = 1;
 };
 
+// A filter read from a file the scene names ([filters] in a scene file): a
+// band like the built-in filters (illumination/filters.h).
+struct SceneFilter {
+  std::string name;   // as `bands` names it
+  std::string path;   // resolved against the scene's folder
+  Passband passband;  // illumination/filter_file.h
+};
+
+// The spectral renderer ([spectral] in a scene file; docs/scene.md,
+// docs/spectral.md): every band integrated over wavelength through its filter
+// (Barres 2023) instead of the band renderer's one extinction ratio and star
+// power per band. Single scattering in each voxel (the thin-voxel HG phase
+// function), no tables, no light between voxels.
+struct SpectralSpec {
+  std::string method = "projection";  // double, analytic, projection, light_density
+  int basis = 4;                      // elements of the greedy basis, 1..16
+  int wavelengths = 20;               // double: wavelength samples, 2..4096
+  std::string attenuation = "law";    // law (dust.law, dust.R_V) or inverse (C_T / lambda, the report's)
+  std::string norm = "relative";      // relative (ours) or absolute (the report's)
+  double fit_depth = 0;               // V-band optical paths the basis is fitted on; 0: automatic (8)
+  double max_depth = 0;               // the coefficient table's range; 0: automatic
+  double range_lo_um = 0, range_hi_um = 0;  // the basis' wavelength range; 0: the bands' span
+};
+
 // A file a scene reads: the key that names it ("scene" for the scene file
 // itself) and the path as resolved. Front ends refuse to write over any of them.
 struct SceneInput {
@@ -102,6 +127,8 @@ struct Scene {
   // fills it; empty for a scene built in code): equal texts, equal grids.
   std::string grid_source;
   std::vector<std::string> bands{"B", "V", "R"};
+  std::vector<SceneFilter> filters;        // user filters the bands may name
+  std::optional<SpectralSpec> spectral;    // set: render with the spectral renderer
   DensityGrid density;  // tau_v per voxel (empty for an axial scene)
   std::optional<AxialSpec> axial;  // set instead of a density grid
   // Empty, or one grid per band (bands order) with the density's shape: the

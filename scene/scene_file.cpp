@@ -18,6 +18,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "illumination/filter_file.h"
 #include "illumination/star.h"
 #include "scene/scene_checks.h"
 
@@ -58,8 +59,11 @@ const char* type_name(const toml::node& n) {
 }
 
 // The keys of every table in a scene file.
-const std::initializer_list<std::string_view> kTopKeys = {"bands",  "density", "emission", "dust",
-                                                          "stars",  "camera",  "output", "render", "axial"};
+const std::initializer_list<std::string_view> kTopKeys = {"bands",  "density", "emission", "dust",   "stars",
+                                                          "camera", "output",  "render",   "axial",  "filters",
+                                                          "spectral"};
+const std::initializer_list<std::string_view> kSpectralKeys = {
+    "method", "basis", "wavelengths", "attenuation", "norm", "fit_depth", "max_depth", "range_um"};
 const std::initializer_list<std::string_view> kRenderKeys = {
     "levels", "multiple_scattering", "diffuse_order", "diffuse_cells", "diffuse_photons", "diffuse_seed",
     "samples_per_pixel"};
@@ -250,7 +254,9 @@ class Parser {
 
   // ------------------------------------------------ sections
 
-  std::vector<std::string> parse_bands(const toml::table& root) const;
+  std::vector<std::string> parse_bands(const toml::table& root, const std::vector<SceneFilter>& filters) const;
+  std::vector<SceneFilter> parse_filters(const toml::table& root) const;
+  std::optional<SpectralSpec> parse_spectral(const toml::table& root) const;
   DensityPlan parse_density(const toml::table& root) const;
   AxialSpec parse_axial(const toml::table& root, const std::vector<std::string>& bands) const;
   ProceduralParams parse_procedural(const toml::table& t, const std::string& key) const;
@@ -349,7 +355,50 @@ void Parser::apply_override(toml::table& root, const std::string& text) {
 
 // ------------------------------------------------------------ sections
 
-std::vector<std::string> Parser::parse_bands(const toml::table& root) const {
+std::vector<SceneFilter> Parser::parse_filters(const toml::table& root) const {
+  std::vector<SceneFilter> filters;
+  const toml::node* n = root.get("filters");
+  if (n == nullptr) return filters;
+  const toml::table& t = table_at(*n, "filters");
+  for (auto&& [k, v] : t) {
+    SceneFilter f;
+    f.name = std::string(k.str());
+    const std::string key = "filters." + f.name;
+    f.path = data_path(v, key);
+    try {
+      f.passband = load_filter_file(f.path);
+    } catch (const Error& e) {
+      fail(key, e.what());
+    }
+    filters.push_back(std::move(f));
+  }
+  return filters;
+}
+
+std::optional<SpectralSpec> Parser::parse_spectral(const toml::table& root) const {
+  const toml::node* n = root.get("spectral");
+  if (n == nullptr) return std::nullopt;
+  const toml::table& t = table_at(*n, "spectral");
+  known_keys(t, "spectral", kSpectralKeys);
+  SpectralSpec p;
+  if (const toml::node* v = t.get("method")) p.method = lower(string(*v, "spectral.method"));
+  if (const toml::node* v = t.get("basis")) p.basis = small_integer(*v, "spectral.basis");
+  if (const toml::node* v = t.get("wavelengths")) p.wavelengths = small_integer(*v, "spectral.wavelengths");
+  if (const toml::node* v = t.get("attenuation")) p.attenuation = lower(string(*v, "spectral.attenuation"));
+  if (const toml::node* v = t.get("norm")) p.norm = lower(string(*v, "spectral.norm"));
+  if (const toml::node* v = t.get("fit_depth")) p.fit_depth = number(*v, "spectral.fit_depth");
+  if (const toml::node* v = t.get("max_depth")) p.max_depth = number(*v, "spectral.max_depth");
+  if (const toml::node* v = t.get("range_um")) {
+    const toml::array* a = v->as_array();
+    if (a == nullptr || a->size() != 2)
+      fail("spectral.range_um", "must be an array of 2 numbers [lo, hi] in um");
+    p.range_lo_um = number((*a)[0], "spectral.range_um[0]");
+    p.range_hi_um = number((*a)[1], "spectral.range_um[1]");
+  }
+  return p;
+}
+
+std::vector<std::string> Parser::parse_bands(const toml::table& root, const std::vector<SceneFilter>& filters) const {
   const toml::node* n = root.get("bands");
   if (n == nullptr) return {"B", "V", "R"};
   const toml::array* a = n->as_array();
@@ -358,7 +407,7 @@ std::vector<std::string> Parser::parse_bands(const toml::table& root) const {
   for (size_t i = 0; i < a->size(); ++i) bands.push_back(string((*a)[i], "bands[" + std::to_string(i) + "]"));
   if (bands.empty()) fail("bands", "must name at least one band");
   for (size_t i = 0; i < bands.size(); ++i) {
-    if (auto issue = scene_detail::band_issue(bands[i])) fail(issue->key, issue->reason);
+    if (auto issue = scene_detail::band_issue(bands[i], filters)) fail(issue->key, issue->reason);
     for (size_t j = 0; j < i; ++j)
       if (bands[j] == bands[i]) fail("bands", "'" + bands[i] + "' appears twice");
   }
@@ -747,7 +796,9 @@ Scene Parser::build(toml::table& root, const Scene* reuse_grids) {
   known_keys(root, "", kTopKeys);
   Scene scene;
   scene.path = name_;
-  scene.bands = parse_bands(root);
+  scene.filters = parse_filters(root);
+  scene.bands = parse_bands(root, scene.filters);
+  scene.spectral = parse_spectral(root);
   const bool axial = root.get("axial") != nullptr;
   if (axial && root.get("density") != nullptr)
     fail_tables("axial", "conflicts with [density]: a scene is either a 3D grid or an axial map", {"axial", "density"});
@@ -786,6 +837,7 @@ Scene Parser::build(toml::table& root, const Scene* reuse_grids) {
   if (!density.path.empty()) scene.inputs.push_back({density.key, density.path});
   if (emission) scene.inputs.push_back({"emission.file", emission->path});
   if (axial && !scene.axial->path.empty()) scene.inputs.push_back({"axial." + scene.axial->source, scene.axial->path});
+  for (const SceneFilter& f : scene.filters) scene.inputs.push_back({"filters." + f.name, f.path});
   for (size_t b = 0; b < scene.dust.table_files.size(); ++b)
     if (!scene.dust.table_files[b].empty())
       scene.inputs.push_back({"dust.tables." + scene.bands[b], scene.dust.table_files[b]});
