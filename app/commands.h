@@ -12,5 +12,6 @@ void add_bench_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_truth_command(CLI::App& app);
 void add_compare_command(CLI::App& app);
+void add_animate_command(CLI::App& app);
 
 }  // namespace nebula::app

@@ -147,13 +147,28 @@ void write_png(const Image& image, const ImageMetadata& metadata, const std::str
   OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::UINT8);
   spec.attribute("oiio:ColorSpace", "sRGB");
   spec.attribute(kPrefix + kBandsName, join_bands(image.bands));
-  spec.attribute("nebula:tone_map", "value x exposure, clamped to [0, 1], sRGB curve (IEC 61966-2-1)");
-  add_metadata(spec, metadata);
+  const DisplaySettings& display = metadata.display;
+  // Auto exposure looks at the bands shown only.
+  double exposure = metadata.exposure;
   const size_t plane = image.plane_size();
+  if (display.auto_exposure) {
+    std::vector<float> shown;
+    shown.reserve(plane * channels);
+    for (int c = 0; c < channels; ++c)
+      if (source[c] < int(image.bands.size()))
+        shown.insert(shown.end(), image.pixels.begin() + std::ptrdiff_t(source[c] * plane),
+                     image.pixels.begin() + std::ptrdiff_t((source[c] + 1) * plane));
+    exposure = auto_exposure_of(shown, display, metadata.exposure);
+  }
+  spec.attribute("nebula:tone_map", std::string(to_string(display.stretch)) + " stretch of value x exposure " +
+                                        exact_text(exposure) + (display.auto_exposure ? " (auto)" : "") +
+                                        " / white " + exact_text(display.white) + ", softening " +
+                                        exact_text(display.softening) + ", clamped to [0, 1], sRGB curve (IEC 61966-2-1)");
+  add_metadata(spec, metadata);
   std::vector<uint8_t> levels(plane * channels);
   for (size_t i = 0; i < plane; ++i)
     for (int c = 0; c < channels; ++c)
-      levels[i * channels + c] = srgb_level(image.pixels[source[c] * plane + i], metadata.exposure);
+      levels[i * channels + c] = display_level(image.pixels[source[c] * plane + i], exposure, display);
   write_with("png", spec, OIIO::TypeDesc::UINT8, levels.data(), file_name);
 }
 

@@ -19,6 +19,8 @@
 
 #include "core/error.h"
 #include "illumination/star.h"
+#include "scene/camera_path_toml.h"
+#include "scene/display_toml.h"
 #include "scene/scene_checks.h"
 
 namespace nebula {
@@ -59,7 +61,8 @@ const char* type_name(const toml::node& n) {
 
 // The keys of every table in a scene file.
 const std::initializer_list<std::string_view> kTopKeys = {"bands",  "density", "emission", "dust",
-                                                          "stars",  "camera",  "output", "render", "axial"};
+                                                          "stars",  "camera",  "output", "render", "axial",
+                                                          "animation", "display"};
 const std::initializer_list<std::string_view> kRenderKeys = {
     "levels", "multiple_scattering", "diffuse_order", "diffuse_cells", "diffuse_photons", "diffuse_seed"};
 const std::initializer_list<std::string_view> kAxialKeys = {
@@ -72,7 +75,8 @@ const std::initializer_list<std::string_view> kProceduralKeys = {
     "wind_direction", "bubble_offset",  "bubble_radius",   "bubble_tau",     "shell_thickness",
     "shell_tau",     "cloud_tau",       "scale_length",    "near_side",      "far_multiplier",
     "far_transition", "noise_amplitude", "noise_frequency", "noise_octaves", "noise_gain",
-    "noise_lacunarity"};
+    "noise_lacunarity", "far_offset", "far_warp", "filament_amplitude", "filament_frequency",
+    "filament_octaves", "filament_sharpness"};
 const std::initializer_list<std::string_view> kEmissionKeys = {"file", "prefix"};
 const std::initializer_list<std::string_view> kDustKeys = {"albedo", "g", "R_V", "law", "tables"};
 const std::initializer_list<std::string_view> kStarKeys = {"name", "position", "luminosity_lsun",
@@ -401,6 +405,12 @@ ProceduralParams Parser::parse_procedural(const toml::table& t, const std::strin
   small("noise_octaves", p.noise_octaves);
   num("noise_gain", p.noise_gain);
   num("noise_lacunarity", p.noise_lacunarity);
+  num("far_offset", p.far_offset);
+  num("far_warp", p.far_warp);
+  num("filament_amplitude", p.filament_amplitude);
+  num("filament_frequency", p.filament_frequency);
+  small("filament_octaves", p.filament_octaves);
+  num("filament_sharpness", p.filament_sharpness);
   if (const auto issue = check_procedural(p)) fail(join(key, issue->parameter), issue->reason);
   return p;
 }
@@ -772,6 +782,11 @@ Scene Parser::build(toml::table& root) {
     }
   }
   scene.camera = parse_camera(root);
+  if (const toml::node* a = root.get("animation"))
+    scene.camera_path = scene_detail::parse_camera_path(
+        *a, scene.camera, [this](const std::string& key, const std::string& reason) { fail(key, reason); });
+  if (const toml::node* d = root.get("display"))
+    scene.display = scene_detail::parse_display(*d, [this](const std::string& key, const std::string& reason) { fail(key, reason); });
   parse_output(root, scene);
   parse_render(root, scene);
   if (const auto issue = scene_detail::settings_issue(scene)) fail(issue->key, issue->reason);
