@@ -148,6 +148,9 @@ class Parser {
 
   void apply_override(toml::table& root, const std::string& text);
   Scene build(toml::table& root);
+  // A scene whose grids this one takes over when its [density], [emission]
+  // and bands are the same (load_scene_text_reusing_grids).
+  const Scene* reuse_grids = nullptr;
 
  private:
   // ------------------------------------------------ typed access
@@ -265,6 +268,23 @@ class Parser {
   void parse_render(const toml::table& root, Scene& scene) const;
   void load_grids(const DensityPlan& density, const std::optional<EmissionPlan>& emission,
                   Scene& scene) const;
+  bool reused_grids(const toml::table& root, Scene& scene) const {
+    if (reuse_grids == nullptr || reuse_grids->resolved_toml.empty() || reuse_grids->axial) return false;
+    toml::table previous;
+    try {
+      previous = toml::parse(std::string_view(reuse_grids->resolved_toml));
+    } catch (const toml::parse_error&) {
+      return false;
+    }
+    for (const char* key : {"density", "emission", "bands"}) {
+      const toml::node *a = root.get(key), *b = previous.get(key);
+      if ((a == nullptr) != (b == nullptr)) return false;
+      if (a != nullptr && !(*a == *b)) return false;
+    }
+    scene.density = reuse_grids->density;
+    scene.emission = reuse_grids->emission;
+    return true;
+  }
 
   std::string name_;
   fs::path base_;
@@ -798,13 +818,13 @@ Scene Parser::build(toml::table& root) {
   for (size_t b = 0; b < scene.dust.table_files.size(); ++b)
     if (!scene.dust.table_files[b].empty())
       scene.inputs.push_back({"dust.tables." + scene.bands[b], scene.dust.table_files[b]});
-  if (!axial) load_grids(density, emission, scene);  // the expensive part, last
+  if (!axial && !reused_grids(root, scene)) load_grids(density, emission, scene);  // the expensive part, last
   if (const auto issue = scene_detail::grids_issue(scene)) fail(issue->key, issue->reason);
   return scene;
 }
 
 Scene parse_scene(const std::string& text, const std::string& name, const fs::path& base,
-                  const std::vector<std::string>& overrides) {
+                  const std::vector<std::string>& overrides, const Scene* reuse = nullptr) {
   toml::table root;
   try {
     root = toml::parse(std::string_view(text), std::string_view(name));
@@ -815,6 +835,7 @@ Scene parse_scene(const std::string& text, const std::string& name, const fs::pa
                          std::string(e.description())));
   }
   Parser parser(name, base);
+  parser.reuse_grids = reuse;
   parser.note_file_tables(root);
   for (const std::string& o : overrides) parser.apply_override(root, o);
   std::ostringstream resolved;
@@ -829,6 +850,11 @@ Scene parse_scene(const std::string& text, const std::string& name, const fs::pa
 Scene load_scene_text(const std::string& text, const std::string& name, const std::string& base_dir,
                       const std::vector<std::string>& overrides) {
   return parse_scene(text, name, fs::path(base_dir), overrides);
+}
+
+Scene load_scene_text_reusing_grids(const std::string& text, const std::string& name, const std::string& base_dir,
+                                    const std::vector<std::string>& overrides, const Scene& previous) {
+  return parse_scene(text, name, fs::path(base_dir), overrides, &previous);
 }
 
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {

@@ -25,6 +25,14 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
 Scene load_scene_text(const std::string& text, const std::string& name,
                       const std::string& base_dir, const std::vector<std::string>& overrides = {});
 
+// load_scene_text, taking over `previous`'s density and emission grids
+// instead of reading or generating them again when its resolved [density],
+// [emission] and bands equal this one's (and it was read from the same text
+// and folder: the caller's part). The viewer's re-bake after an edit of the
+// dust, a star or the camera.
+Scene load_scene_text_reusing_grids(const std::string& text, const std::string& name, const std::string& base_dir,
+                                    const std::vector<std::string>& overrides, const Scene& previous);
+
 // The built-in demo (`nebula render --demo`), equal to scenes/demo.toml: the
 // default procedural nebula (128^3 voxels, 2 pc), one O5V star of 2e5 L_sun
 // at the procedural star, a 512 x 512 perspective camera 3.5 pc away on the
