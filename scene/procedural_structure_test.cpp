@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "scene/density_sources.h"
+#include "scene/scene_file.h"
 
 namespace nebula {
 namespace {
@@ -71,6 +72,22 @@ TEST(ProceduralStructure, FarSideBoundaryMovesBehindTheStarAndWarps) {
   }
   EXPECT_GT(differ, 0);
   EXPECT_LT(differ, 32);
+}
+
+TEST(ReuseGrids, TakesTheDensityOverOnlyWhenItsTablesAreUnchanged) {
+  const std::string text =
+      "[density]\nprocedural = { n = 8 }\n[[stars]]\nluminosity_lsun = 1e3\nclass = \"B0V\"\n"
+      "[camera]\nposition = [1, -3, 1]\nlook_at = [1, 1, 1]\n";
+  Scene previous = load_scene_text(text, "s.toml", ".");
+  previous.density.tau_v[0] = 123.0f;  // a mark: seen again only if the grid is taken over
+  const Scene edited = load_scene_text_reusing_grids(text, "s.toml", ".", {"dust.albedo=0.9", "stars.0.luminosity_lsun=5e3"}, previous);
+  EXPECT_EQ(edited.density.tau_v[0], 123.0f);
+  EXPECT_EQ(edited.dust.albedo[0], 0.9);
+  EXPECT_EQ(edited.stars[0].luminosity_lsun, 5e3);
+  const Scene reseeded = load_scene_text_reusing_grids(text, "s.toml", ".", {"density.procedural.seed=2"}, previous);
+  EXPECT_NE(reseeded.density.tau_v[0], 123.0f);
+  const Scene scaled = load_scene_text_reusing_grids(text, "s.toml", ".", {"density.scale=2"}, previous);
+  EXPECT_NE(scaled.density.tau_v[0], 123.0f);
 }
 
 }  // namespace

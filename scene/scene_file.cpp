@@ -279,7 +279,7 @@ class Parser {
     for (const char* key : {"density", "emission", "bands"}) {
       const toml::node *a = root.get(key), *b = previous.get(key);
       if ((a == nullptr) != (b == nullptr)) return false;
-      if (a != nullptr && !(*a == *b)) return false;
+      if (a != nullptr && !(toml::node_view<const toml::node>(a) == toml::node_view<const toml::node>(b))) return false;
     }
     scene.density = reuse_grids->density;
     scene.emission = reuse_grids->emission;
