@@ -13,5 +13,6 @@ void add_render_command(CLI::App& app);
 void add_truth_command(CLI::App& app);
 void add_compare_command(CLI::App& app);
 void add_animate_command(CLI::App& app);
+void add_frame_benchmarks(CLI::App* bench);  // `nebula bench animate`, `nebula bench viewer`
 
 }  // namespace nebula::app

@@ -6,7 +6,8 @@
 // the full one when it rests; screenshots, "save scene" and keyframes. An
 // automation mode (--frames N --set KEY=VALUE --screenshot F) runs the real
 // window and interface for tests and scripted pictures.
-#include <GL/gl.h>
+#define GL_GLEXT_PROTOTYPES  // buffer objects (OpenGL 1.5+) from Mesa's or NVIDIA's libGL
+#define GLFW_INCLUDE_GLEXT
 #include <GLFW/glfw3.h>
 #include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
@@ -31,6 +32,7 @@
 #include "core/gpu.h"
 #include "imageio/image_output.h"
 #include "viewer/display_image.h"
+#include "viewer/gpu_frame.h"
 #include "viewer/navigation.h"
 #include "viewer/viewer_session.h"
 
@@ -267,6 +269,18 @@ int run(const Args& args) {
   ImGui_ImplOpenGL3_Init("#version 330");
 
   Texture texture;
+  // With CUDA, the interactive frame is rendered and tone-mapped on the GPU into a pixel buffer
+  // OpenGL reads (no host round trip); the session's host frames serve screenshots and auto exposure.
+  // Automation keeps to the host frames: its window must equal the screenshot bit for bit.
+  std::unique_ptr<GpuFrame> gpu;
+  if (backend == Backend::Cuda && GpuFrame::available() && !automation) gpu = std::make_unique<GpuFrame>();
+  GLuint pbo = 0;
+  size_t pbo_bytes = 0;
+  CameraSettings gpu_camera{};
+  DisplaySettings gpu_display;
+  double gpu_exposure = -1, gpu_ms = 0;
+  uint64_t gpu_version = 0;
+  bool gpu_shown = false;
   std::optional<Frame> full;  // the last full-resolution frame of the current view
   std::optional<Frame> shown;
   Rgba8 shown_rgba;
@@ -337,17 +351,63 @@ int run(const Args& args) {
 
     // What to render: a reduced size while the camera moves, the full one when it rests.
     const bool moving = !automation && std::chrono::duration<double>(now - last_motion).count() < 0.3;
+    const bool host_frames = !gpu_shown || !moving;  // with the GPU showing, host frames only at rest
     CameraSettings want = view.camera;
     want.exposure = 1;  // display only
     if (moving && preview_scale > 1) {
       want.width = std::max(1, view.camera.width / preview_scale);
       want.height = want.projection == Projection::Fisheye ? want.width : std::max(1, view.camera.height / preview_scale);
     }
-    if (!camera_issue(want) && (!have_request || !same_view(want, requested) || status.version != version_seen)) {
+    if (gpu_shown) want = view.camera, want.exposure = 1;  // full size: the GPU shows the moving frames
+    if (host_frames && !camera_issue(want) && (!have_request || !same_view(want, requested) || status.version != version_seen)) {
       session.request(want);
       requested = want;
       have_request = true;
       version_seen = status.version;
+    }
+    // The GPU frame: every change of view, display or scene, at full size.
+    std::shared_ptr<const PreparedGrid> prepared = gpu ? session.prepared() : nullptr;
+    gpu_shown = gpu_shown && prepared != nullptr;
+    if (prepared && !camera_issue(view.camera)) {
+      const double exposure = view.display.auto_exposure && shown_rgba.exposure > 0 ? shown_rgba.exposure : view.camera.exposure;
+      CameraSettings c = view.camera;
+      c.exposure = 1;
+      if (!gpu_shown || !same_view(c, gpu_camera) || !(gpu_display == view.display) || gpu_exposure != exposure ||
+          gpu_version != status.version) {
+        const size_t bytes = size_t(c.width) * c.height * 4;
+        if (pbo == 0) glGenBuffers(1, &pbo);
+        glBindBuffer(GL_PIXEL_UNPACK_BUFFER, pbo);
+        if (bytes > pbo_bytes) {
+          glBufferData(GL_PIXEL_UNPACK_BUFFER, GLsizeiptr(bytes), nullptr, GL_STREAM_DRAW);
+          pbo_bytes = bytes;
+        }
+        glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+        try {
+          RenderInputs in = prepared->inputs;
+          in.camera = make_camera(c);
+          in.exposure = 1.0f;
+          gpu_ms = 1e3 * gpu->render_to_gl(in, exposure, view.display, pbo);
+          if (texture.id == 0) glGenTextures(1, &texture.id);
+          glBindTexture(GL_TEXTURE_2D, texture.id);
+          glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+          glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+          glBindBuffer(GL_PIXEL_UNPACK_BUFFER, pbo);
+          glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+          glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, c.width, c.height, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+          glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+          texture.width = c.width;
+          texture.height = c.height;
+          gpu_camera = c;
+          gpu_display = view.display;
+          gpu_exposure = exposure;
+          gpu_version = status.version;
+          gpu_shown = true;
+        } catch (const std::exception& e) {
+          message = std::string("GPU frame: ") + e.what() + "; showing the session's frames";
+          gpu.reset();
+          gpu_shown = false;
+        }
+      }
     }
     bool new_pixels = false;
     if (std::optional<Frame> f = session.take_frame()) {
@@ -359,7 +419,7 @@ int run(const Args& args) {
     static double shown_exposure = 0;
     if (shown && (new_pixels || !(shown_display == view.display) || shown_exposure != view.camera.exposure)) {
       shown_rgba = display_image(shown->image, view.camera.exposure, view.display);
-      texture.upload(shown_rgba);
+      if (!gpu_shown) texture.upload(shown_rgba);
       shown_display = view.display;
       shown_exposure = view.camera.exposure;
     }
@@ -379,8 +439,12 @@ int run(const Args& args) {
       ImGui::SetNextWindowSize(ImVec2(380, 0), ImGuiCond_FirstUseEver);
       ImGui::Begin("nebula-view");
       ImGui::Text("%s on the %s", session.source().name().c_str(), backend == Backend::Cuda ? "GPU (CUDA)" : "CPU");
-      ImGui::Text("frame %.1f ms (%dx%d)%s", status.frame_seconds * 1e3, shown ? shown->camera.width : 0,
-                  shown ? shown->camera.height : 0, moving ? ", moving: reduced size" : "");
+      if (gpu_shown)
+        ImGui::Text("GPU frame %.2f ms (%dx%d, CUDA-OpenGL interop); host frame %.1f ms", gpu_ms, texture.width,
+                    texture.height, status.frame_seconds * 1e3);
+      else
+        ImGui::Text("frame %.1f ms (%dx%d)%s", status.frame_seconds * 1e3, shown ? shown->camera.width : 0,
+                    shown ? shown->camera.height : 0, moving ? ", moving: reduced size" : "");
       ImGui::Text("bake %.2f s; %s", status.bake_seconds, status.activity.c_str());
       if (!status.error.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", status.error.c_str());
       if (!message.empty()) ImGui::TextWrapped("%s", message.c_str());
@@ -576,6 +640,8 @@ int run(const Args& args) {
                 backend == Backend::Cuda ? "GPU" : "CPU");
     if (!args.window_shot.empty()) std::printf("wrote %s\n", args.window_shot.c_str());
   }
+  if (pbo) glDeleteBuffers(1, &pbo);
+  gpu.reset();
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();

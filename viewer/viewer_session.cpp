@@ -184,6 +184,14 @@ SceneSource Session::source() const {
   return source_;
 }
 
+std::shared_ptr<const PreparedGrid> Session::prepared() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!baked_ || baked_->scene->axial || baked_->scene->pyramid_levels > 0 ||
+      baked_->scene->multiple_scattering == MultipleScattering::Pyramid)
+    return nullptr;
+  return std::shared_ptr<const PreparedGrid>(baked_, &baked_->prepared);
+}
+
 void Session::sync_scene() {
   std::lock_guard<std::mutex> lock(mutex_);
   shown_scene_ = latest_scene_;
@@ -220,7 +228,7 @@ void Session::work() {
       status_.activity = "baking (" + why_ + ")";
       status_.busy = true;
       lock.unlock();
-      std::unique_ptr<Baked> fresh;
+      std::shared_ptr<Baked> fresh;
       std::string error;
       const auto t0 = std::chrono::steady_clock::now();
       try {
@@ -230,7 +238,7 @@ void Session::work() {
         o.backend = options_.backend;
         o.table_photons = options_.table_photons;
         o.smooth_step = options_.smooth_step;
-        fresh = std::make_unique<Baked>(scene, o);
+        fresh = std::make_shared<Baked>(scene, o);
       } catch (const std::exception& e) {
         error = e.what();
       }
@@ -255,6 +263,7 @@ void Session::work() {
       const CameraSettings camera = *wanted_camera_;
       const uint64_t request = wanted_request_;
       const uint64_t version = baked_version_;
+      const std::shared_ptr<const Baked> current = baked_;
       status_.activity = "rendering " + std::to_string(camera.width) + "x" + std::to_string(camera.height);
       status_.busy = true;
       lock.unlock();
@@ -262,7 +271,7 @@ void Session::work() {
       std::string error;
       const auto t0 = std::chrono::steady_clock::now();
       try {
-        RenderOutput out = baked_->render(camera);
+        RenderOutput out = current->render(camera);
         frame.image = std::move(out.image);
         frame.metadata = std::move(out.metadata);
         frame.camera = camera;

@@ -100,6 +100,10 @@ class Session {
   void wait_idle() const;
   // The source with its overrides, for saving.
   SceneSource source() const;
+  // The bake frames come from, shared so the window's thread can render from it
+  // on the GPU (viewer/gpu_frame.h); null before the first bake, for an axial
+  // scene and for the pyramid (rendered by the session only).
+  std::shared_ptr<const PreparedGrid> prepared() const;
   // Refreshes scene() after an edit finished (main thread; cheap when nothing changed).
   void sync_scene();
   // The scene as shown, with this view, as a TOML file `nebula render` reproduces:
@@ -120,7 +124,7 @@ class Session {
   std::optional<CameraSettings> wanted_camera_;
   uint64_t wanted_request_ = 0, rendered_request_ = 0;
   bool working_ = false, stop_ = false;
-  std::unique_ptr<Baked> baked_;                   // the worker's
+  std::shared_ptr<Baked> baked_;                   // replaced by the worker only
   std::shared_ptr<const Scene> latest_scene_;      // set by the worker, taken by sync_scene
   std::shared_ptr<const Scene> shown_scene_;       // the main thread's
   std::optional<Frame> frame_;
