@@ -524,12 +524,19 @@ int run(const Args& args) {
           const std::string key = "stars." + std::to_string(i);
           float lum = float(std::log10(s.luminosity_lsun));
           if (ImGui::SliderFloat("log10 L/L_sun", &lum, -2, 7)) edit(key + ".luminosity_lsun", toml_number(std::pow(10.0, lum)));
+          // A class or a temperature replaces the star's entry whole (a file's class and temperature must agree).
+          auto star_entry = [&](const std::string& kind) {
+            return "{name = \"" + s.name + "\", position = " + toml_vec3(s.position) +
+                   ", luminosity_lsun = " + toml_number(s.luminosity_lsun) + ", " + kind + "}";
+          };
           float t = float(s.temperature_K);
-          if (ImGui::SliderFloat("temperature K", &t, 2500, 50000, "%.0f", ImGuiSliderFlags_Logarithmic)) {
-            // A temperature replaces the class (the two must agree in a scene file).
-            session.edit(key + ".class", "\"\"");
-            edit(key + ".temperature_K", toml_number(t));
-          }
+          if (ImGui::SliderFloat("temperature K", &t, 2500, 50000, "%.0f", ImGuiSliderFlags_Logarithmic))
+            edit(key, star_entry("temperature_K = " + toml_number(t)));
+          const char* classes[] = {"O5V", "B0V", "B5V", "A0V", "G2V", "M0V"};
+          int which = -1;
+          for (int c = 0; c < 6; ++c)
+            if (s.spectral_class == classes[c]) which = c;
+          if (ImGui::Combo("class", &which, classes, 6)) edit(key, star_entry(std::string("class = \"") + classes[which] + "\""));
           float p[3] = {s.position.x, s.position.y, s.position.z};
           if (ImGui::DragFloat3("position pc", p, 0.01f)) edit(key + ".position", toml_vec3(Vec3{p[0], p[1], p[2]}));
           ImGui::PopID();

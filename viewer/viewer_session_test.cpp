@@ -100,6 +100,21 @@ TEST_F(ViewerSession, TheSavedSceneRendersTheSameImage) {
   EXPECT_EQ(rendered.image.pixels, shown.image.pixels);
 }
 
+TEST_F(ViewerSession, AStarsTemperatureReplacesItsClass) {
+  Session s(SceneSource(kScene, "v.toml", "."), options());
+  const CameraSettings camera = s.scene().camera;
+  const Frame hot = frame_of(s, camera);
+  // The viewer's edit: the star's entry whole, with a temperature instead of the class.
+  s.edit("stars.0", "{name = \"star 0\", position = [1, 1, 1], luminosity_lsun = 2e5, temperature_K = 5770}");
+  const Frame cool = frame_of(s, camera);
+  EXPECT_TRUE(s.status().error.empty()) << s.status().error;
+  s.sync_scene();
+  EXPECT_EQ(s.scene().stars[0].temperature_K, 5770);
+  EXPECT_EQ(s.scene().stars[0].spectral_class, "");
+  // The same bolometric luminosity: a Sun-like star puts far more of it in B, V and R than an O5V star.
+  EXPECT_GT(total(cool.image), 2 * total(hot.image));
+}
+
 TEST_F(ViewerSession, RecordedKeyframesAreSavedAsACameraPath) {
   Session s(SceneSource(kScene, "v.toml", "."), options());
   CameraKeyframe a, b;
