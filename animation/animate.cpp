@@ -151,9 +151,27 @@ AnimateResult animate(const Scene& scene, const AnimateOptions& o) {
   AnimateResult result;
   result.plan = plan;
   result.manifest = manifest;
+  const bool made_folder = !fs::exists(folder, ec);
   fs::create_directories(folder, ec);
   if (ec) throw ParameterError("pattern", "cannot make the folder '" + folder + "' (" + ec.message() + ")");
+  const bool had_manifest = fs::exists(manifest, ec);
+  const std::string old_manifest = had_manifest ? read_text(manifest) : "";
   write_text_atomically(manifest, record);
+  // A failure before the first frame (a bake refused, say) leaves the disk as it was.
+  struct Undo {
+    bool armed = true;
+    std::function<void()> action;
+    ~Undo() {
+      if (armed) action();
+    }
+  } undo{true, [&] {
+    std::error_code ignored;
+    if (had_manifest)
+      write_text_atomically(manifest, old_manifest);
+    else
+      fs::remove(manifest, ignored);
+    if (made_folder) fs::remove(folder, ignored);  // only when empty
+  }};
 
   // One bake for every frame. PreparedGrid points into itself (the diffuse
   // field, the bakes): it stays where prepare_grid built it, never moved.
@@ -182,6 +200,7 @@ AnimateResult animate(const Scene& scene, const AnimateOptions& o) {
       frame.metadata.entries.push_back({"frame_time_s", plan.time(k)});
       const auto t1 = std::chrono::steady_clock::now();
       write_image(frame.image, file, frame.metadata, true);
+      undo.armed = false;
       result.write_seconds += seconds_since(t1);
       ++result.rendered;
       if (bar) bar->add(1);

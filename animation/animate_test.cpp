@@ -162,6 +162,13 @@ TEST_F(Animate, BadInputWritesNothing) {
   EXPECT_FALSE(fs::exists(path("movie.mp4")));
 }
 
+TEST_F(Animate, AFailedBakeLeavesNothingBehind) {
+  // 4 pyramid levels on a 16^3 grid (3 at most): refused by prepare_grid, after the checks up front.
+  const Scene s = scene({"render.levels=4"});
+  EXPECT_THROW(animate(s, options()), ParameterError);
+  EXPECT_FALSE(fs::exists(path("frames")));
+}
+
 TEST_F(Animate, MissingFfmpegIsOneClearLine) {
   const Scene s = scene();
   AnimateOptions o = options("frames/f_%03d.png");
