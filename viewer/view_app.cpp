@@ -292,6 +292,8 @@ int run(const Args& args) {
   std::string message;
   int frames = 0;
   bool hide_panels = false, last_frame_with_panels = false, last_frame_with_panels_drawn = false;
+  bool truth_on = false, show_truth = false;
+  int truth_shown_passes = -1;
   const char* kinds[] = {"perspective", "orthographic", "fisheye"};
   const char* stretches[] = {"linear", "asinh", "log"};
   const char* modes[] = {"diffuse", "pyramid", "none"};
@@ -424,6 +426,15 @@ int run(const Args& args) {
       shown_exposure = view.camera.exposure;
     }
 
+    // The ground truth, accumulated by the session while the camera rests, shown instead when asked.
+    std::optional<TruthFrame> truth = truth_on ? session.truth() : std::nullopt;
+    if (show_truth && truth && !gpu_shown && (truth->passes != truth_shown_passes || new_pixels)) {
+      texture.upload(display_image(truth->mean, view.camera.exposure, view.display));
+      truth_shown_passes = truth->passes;
+    } else if (!show_truth && truth_shown_passes >= 0 && shown) {
+      texture.upload(shown_rgba);
+      truth_shown_passes = -1;
+    }
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
@@ -459,6 +470,22 @@ int run(const Args& args) {
         if (r.diffuse.done)
           ImGui::Text("diffuse field: %llu photons/band, degree %d, %.2f s", (unsigned long long)r.diffuse.photons_per_band,
                       r.diffuse.order, r.diffuse.wall_seconds);
+      }
+      if (ImGui::CollapsingHeader("Ground truth")) {
+        if (ImGui::Checkbox("accumulate the truth while the camera rests", &truth_on)) session.set_truth(truth_on);
+        ImGui::Checkbox("show the truth instead of the fast frame", &show_truth);
+        if (truth) {
+          ImGui::Text("truth: %d samples per pixel and band, noise %.2f%% (standard error of the total)", truth->spp,
+                      100 * truth->noise);
+          if (full && full->image.pixels.size() == truth->mean.pixels.size()) {
+            double fast = 0, exact = 0;
+            for (size_t i = 0; i < truth->mean.pixels.size(); ++i) fast += full->image.pixels[i], exact += truth->mean.pixels[i];
+            if (exact > 0)
+              ImGui::Text("fast against truth: %+.2f%% +- %.2f%% in total", 100 * (fast - exact) / exact, 100 * truth->noise);
+          }
+        } else if (truth_on) {
+          ImGui::TextDisabled("waiting for the camera to rest");
+        }
       }
       if (ImGui::CollapsingHeader("Camera", ImGuiTreeNodeFlags_DefaultOpen)) {
         int kind = int(view.camera.projection);

@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -13,6 +14,9 @@
 
 namespace nebula::viewer {
 namespace {
+
+// Passes of the ground truth accumulated for one view at most (256 samples per pixel).
+constexpr int kTruthPasses = 128;
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -160,6 +164,20 @@ std::optional<Frame> Session::take_frame() {
   return out;
 }
 
+void Session::set_truth(bool on) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    truth_on_ = on;
+    if (!on) truth_.reset();
+  }
+  wake_.notify_all();
+}
+
+std::optional<TruthFrame> Session::truth() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return truth_;
+}
+
 SessionStatus Session::status() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return status_;
@@ -217,11 +235,76 @@ void Session::work() {
   while (true) {
     wake_.wait(lock, [&] {
       return stop_ || wanted_version_ != baked_version_ ||
-             (wanted_camera_ && baked_ && wanted_request_ != rendered_request_);
+             (wanted_camera_ && baked_ && wanted_request_ != rendered_request_) ||
+             (truth_on_ && baked_ && truth_camera_ && (!truth_ || truth_->passes < kTruthPasses));
     });
     if (stop_) return;
     working_ = true;
-    if (wanted_version_ != baked_version_) {
+    const bool other_work = wanted_version_ != baked_version_ || (wanted_camera_ && baked_ && wanted_request_ != rendered_request_);
+    if (!other_work) {
+      // A pass of the ground truth for the last view: only when nothing else waits.
+      const CameraSettings camera = *truth_camera_;
+      const std::shared_ptr<const Baked> current = baked_;
+      const uint64_t version = baked_version_;
+      std::optional<TruthFrame> sum = truth_;
+      if (sum && (sum->version != version || !(sum->camera.width == camera.width && sum->camera.height == camera.height &&
+                                               sum->camera.position.x == camera.position.x &&
+                                               sum->camera.position.y == camera.position.y &&
+                                               sum->camera.position.z == camera.position.z &&
+                                               sum->camera.look_at.x == camera.look_at.x &&
+                                               sum->camera.look_at.y == camera.look_at.y &&
+                                               sum->camera.look_at.z == camera.look_at.z &&
+                                               sum->camera.fov_deg == camera.fov_deg &&
+                                               sum->camera.projection == camera.projection)))
+        sum.reset();
+      const int pass = sum ? sum->passes : 0;
+      status_.activity = "ground truth: pass " + std::to_string(pass + 1);
+      status_.busy = true;
+      lock.unlock();
+      std::string error;
+      try {
+        Scene scene = *current->scene;
+        scene.camera = camera;
+        TruthOptions t;
+        t.backend = options_.backend;
+        t.spp = 2;
+        t.seed = uint64_t(pass) + 1;  // independent passes
+        const TruthRenderOutput out = truth_scene(scene, t);
+        if (!sum) {
+          sum = TruthFrame{};
+          sum->mean = out.image;
+          sum->variance = out.variance;
+          for (float& v : sum->mean.pixels) v = 0;
+          for (float& v : sum->variance.pixels) v = 0;
+          sum->camera = camera;
+          sum->version = version;
+        }
+        // Running mean of equal passes; the variance of the mean of K passes is sum(var_k) / K^2.
+        const int k = pass + 1;
+        for (size_t i = 0; i < sum->mean.pixels.size(); ++i) {
+          sum->mean.pixels[i] += (out.image.pixels[i] - sum->mean.pixels[i]) / float(k);
+          const double var_sum = double(sum->variance.pixels[i]) * (k - 1) * (k - 1) + out.variance.pixels[i];
+          sum->variance.pixels[i] = float(var_sum / (double(k) * k));
+        }
+        sum->passes = k;
+        sum->spp = 2 * k;
+        double total = 0, var = 0;
+        for (size_t i = 0; i < sum->mean.pixels.size(); ++i) {
+          total += sum->mean.pixels[i];
+          var += sum->variance.pixels[i];
+        }
+        sum->noise = total > 0 ? std::sqrt(var) / total : 0;
+      } catch (const std::exception& e) {
+        error = e.what();
+      }
+      lock.lock();
+      if (!error.empty()) {
+        status_.error = "ground truth: " + error;
+        truth_on_ = false;
+      } else if (truth_on_ && version == baked_version_) {
+        truth_ = std::move(sum);
+      }
+    } else if (wanted_version_ != baked_version_) {
       const uint64_t version = wanted_version_;
       const SceneSource source = source_;
       const std::shared_ptr<const Scene> previous = latest_scene_;
@@ -284,6 +367,8 @@ void Session::work() {
       lock.lock();
       if (error.empty()) {
         status_.frame_seconds = frame.seconds;
+        truth_camera_ = camera;
+        truth_.reset();  // a new view or a new bake: the truth starts again
         frame_ = std::move(frame);
       } else {
         status_.error = error;
@@ -291,7 +376,8 @@ void Session::work() {
       rendered_request_ = request;
     }
     working_ = false;
-    const bool more = wanted_version_ != baked_version_ || (wanted_camera_ && baked_ && wanted_request_ != rendered_request_);
+    const bool more = wanted_version_ != baked_version_ || (wanted_camera_ && baked_ && wanted_request_ != rendered_request_) ||
+                      (truth_on_ && truth_ && truth_->passes < kTruthPasses);
     if (!more) {
       status_.activity = "idle";
       status_.busy = false;

@@ -69,6 +69,17 @@ struct Frame {
   uint64_t version = 0;    // the scene version it shows
 };
 
+// The ground truth accumulated for one view while the camera rests: the mean
+// of equal passes of the path tracer (`nebula truth`, 2 samples per pixel and
+// band each, seeds 1, 2, ...) and the variance of that mean.
+struct TruthFrame {
+  Image mean, variance;
+  CameraSettings camera;
+  int passes = 0, spp = 0;  // spp: samples per pixel and band so far
+  double noise = 0;         // relative standard error of the image's total: sqrt(sum var) / sum mean
+  uint64_t version = 0;
+};
+
 struct SessionStatus {
   std::string activity = "starting";  // "baking (dust.albedo changed)", "rendering 256x256", "idle"
   std::string error;                  // the last failed edit's one-line error (its scene was kept)
@@ -95,6 +106,10 @@ class Session {
   void edit(const std::string& key, const std::string& value);
   void request(const CameraSettings& camera);  // render this view next; a newer request replaces it
   std::optional<Frame> take_frame();           // the newest finished frame, once
+  // Ground truth: while on and nothing else is pending, the worker adds path-tracer
+  // passes for the last view rendered; a new view or edit starts again.
+  void set_truth(bool on);
+  std::optional<TruthFrame> truth() const;  // the accumulation so far, if any
   SessionStatus status() const;
   bool idle() const;  // nothing pending or running
   void wait_idle() const;
@@ -128,6 +143,9 @@ class Session {
   std::shared_ptr<const Scene> latest_scene_;      // set by the worker, taken by sync_scene
   std::shared_ptr<const Scene> shown_scene_;       // the main thread's
   std::optional<Frame> frame_;
+  bool truth_on_ = false;
+  std::optional<CameraSettings> truth_camera_;  // the last view rendered
+  std::optional<TruthFrame> truth_;
   SessionStatus status_;
   std::thread thread_;
 };

@@ -6,7 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <chrono>
+#include <cmath>
 #include <numeric>
+#include <thread>
 
 #include "core/test_support.h"
 #include "imageio/image_output.h"
@@ -113,6 +116,48 @@ TEST_F(ViewerSession, AStarsTemperatureReplacesItsClass) {
   EXPECT_EQ(s.scene().stars[0].spectral_class, "");
   // The same bolometric luminosity: a Sun-like star puts far more of it in B, V and R than an O5V star.
   EXPECT_GT(total(cool.image), 2 * total(hot.image));
+}
+
+TEST_F(ViewerSession, TheTruthAccumulatesWhileTheCameraRests) {
+  Session s(SceneSource(kScene, "v.toml", "."), options());
+  const CameraSettings camera = s.scene().camera;
+  frame_of(s, camera);
+  s.set_truth(true);
+  std::optional<TruthFrame> six;
+  for (int i = 0; i < 600 && !(six && six->passes >= 6); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    six = s.truth();
+  }
+  s.set_truth(false);
+  ASSERT_TRUE(six && six->passes >= 6);
+  EXPECT_EQ(six->spp, 2 * six->passes);
+  // The accumulation is the mean of `nebula truth` passes with seeds 1, 2, ..., its variance
+  // the sum of theirs over K^2.
+  Scene scene = s.scene();
+  scene.camera = camera;
+  const int K = six->passes;
+  std::vector<double> mean(six->mean.pixels.size(), 0.0);
+  double var = 0, first_var = 0, first_sum = 0;
+  for (int k = 1; k <= K; ++k) {
+    TruthOptions t;
+    t.spp = 2;
+    t.seed = uint64_t(k);
+    const TruthRenderOutput out = truth_scene(scene, t);
+    for (size_t i = 0; i < mean.size(); ++i) {
+      mean[i] += out.image.pixels[i] / double(K);
+      var += out.variance.pixels[i] / (double(K) * K);
+      if (k == 1) first_var += out.variance.pixels[i], first_sum += out.image.pixels[i];
+    }
+  }
+  double diff = 0, sum = 0;
+  for (size_t i = 0; i < mean.size(); ++i) {
+    diff += std::fabs(mean[i] - six->mean.pixels[i]);
+    sum += mean[i];
+  }
+  EXPECT_NEAR(six->noise, std::sqrt(var) / sum, 1e-4 * six->noise);
+  // The noise falls as 1/sqrt(K) against one pass (a third of slack for the variance estimates' own noise).
+  EXPECT_LT(six->noise, 1.33 * std::sqrt(first_var) / first_sum / std::sqrt(double(K)));
+  EXPECT_LT(diff, 1e-5 * sum);  // float rounding of the running mean only
 }
 
 TEST_F(ViewerSession, RecordedKeyframesAreSavedAsACameraPath) {
