@@ -24,6 +24,11 @@ xvfb, view, nebula, work = sys.argv[1:5]
 shutil.rmtree(work, ignore_errors=True)
 os.makedirs(work)
 env = dict(os.environ, NEBULA_CACHE_DIR=os.path.join(work, "cache"))
+# Under scripts/test-sanitize.sh: Mesa's driver is unloaded when the window closes, so
+# LeakSanitizer sees its allocations in an "<unknown module>" it can neither name nor
+# suppress. The viewer's own code (the session, without a window) is leak-checked by
+# viewer_tests; the window's process is checked for everything but leaks.
+view_env = dict(env, ASAN_OPTIONS=(env.get("ASAN_OPTIONS", "") + ":detect_leaks=0").lstrip(":"))
 with open(os.path.join(work, "s.toml"), "w") as f:
     f.write("""[density]
 procedural = { n = 24, size_pc = 2.0 }
@@ -42,7 +47,7 @@ exposure = 0.05
 def run_view(*args, expect_ok=True):
     cmd = [xvfb, "-a", "-s", "-screen 0 1024x768x24", view, "s.toml", "--backend", "cpu",
            "--preview-photons", "16384", "--table-photons", "2000", *args]
-    r = subprocess.run(cmd, cwd=work, env=env, capture_output=True, text=True, timeout=300)
+    r = subprocess.run(cmd, cwd=work, env=view_env, capture_output=True, text=True, timeout=300)
     if expect_ok and r.returncode != 0:
         sys.exit(f"FAIL: {' '.join(args)}: exit {r.returncode}: {r.stdout} {r.stderr}")
     return r
