@@ -1,7 +1,11 @@
 // `nebula bench ...`: the speed studies of validation/benchmarks.h, one
 // subcommand each, printed as the Markdown tables of docs/performance.md.
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -11,6 +15,7 @@
 #include "axial/axial_renderer.h"
 #include "core/error.h"
 #include "core/gpu.h"
+#include "imageio/image_output.h"
 #include "validation/benchmarks.h"
 
 namespace nebula::app {
@@ -301,6 +306,82 @@ void add_axial(CLI::App* bench) {
   });
 }
 
+
+// Issue 16's sweep goal: a parameter study in one `nebula sweep` against the
+// same points as separate `nebula render` runs, both as a user runs them
+// (whole processes: start-up, scene load, bakes, render, file written), the
+// tables generated once beforehand so that neither side pays for them.
+void add_sweep(CLI::App* bench) {
+  struct Options : Common {
+    std::string scene = "scenes/fig12_reference.toml", albedos = "0.3:0.9:7", gs = "0,0.3,0.6,0.9";
+    std::string table_photons = "3e4", work = "";
+    int width = 512, height = 512;
+  };
+  auto o = std::make_shared<Options>();
+  CLI::App* cmd = add_bench(bench, "sweep",
+                            "an albedo x g sweep in one `nebula sweep` against separate `nebula render` runs", *o);
+  cmd->add_option("--scene", o->scene, "the scene")->capture_default_str();
+  cmd->add_option("--albedos", o->albedos, "dust.albedo values (START:STOP:COUNT or a list)")->capture_default_str();
+  cmd->add_option("--gs", o->gs, "dust.g values")->capture_default_str();
+  add_frame(cmd, o->width, o->height);
+  cmd->add_option("--table-photons", o->table_photons, "photons per row of the tables (made once, before timing)")
+      ->capture_default_str();
+  cmd->add_option("--work", o->work, "folder for the images (default: a temporary one)");
+  cmd->callback([o] {
+    const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
+    const std::string work = o->work.empty() ? (std::filesystem::temp_directory_path() / "nebula_bench_sweep").string()
+                                             : o->work;
+    std::filesystem::create_directories(work);
+    const CubeAxis albedo = parse_grid_axis("dust.albedo=" + o->albedos), g = parse_grid_axis("dust.g=" + o->gs);
+    auto run = [](const std::string& command) {
+      const auto t0 = std::chrono::steady_clock::now();
+      if (std::system((command + " > /dev/null").c_str()) != 0) throw Error("bench sweep: failed: " + command);
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    };
+    const std::string frame = " --width " + std::to_string(o->width) + " --height " + std::to_string(o->height) +
+                              " --table-photons " + o->table_photons + " -q --force";
+    for (Backend backend : bench_backends(o->backends)) {
+      const std::string b = std::string(" --backend ") + to_string(backend);
+      // The tables, once: a 1-pixel render of every point generates and caches them.
+      double tables = 0;
+      for (double a : albedo.values)
+        for (double gv : g.values)
+          tables += run(self + " render " + o->scene + " --set dust.albedo=" + to_text(a) + " --set dust.g=" +
+                        to_text(gv) + " --set render.multiple_scattering=none --width 1 --height 1 --table-photons " +
+                        o->table_photons + " -q --force -o " + work + "/table.fits" + b);
+      double separate = 0;
+      size_t i = 0;
+      for (double a : albedo.values)
+        for (double gv : g.values)
+          separate += run(self + " render " + o->scene + " --set dust.albedo=" + to_text(a) + " --set dust.g=" +
+                          to_text(gv) + frame + " -o " + work + "/point" + std::to_string(i++) + ".fits" + b);
+      const double sweep = run(self + " sweep " + o->scene + " --grid dust.albedo=" + o->albedos + " --grid dust.g=" +
+                               o->gs + frame + " -o " + work + "/cube.fits" + b);
+      // The cube against the separate images: the same function, point by point.
+      double worst = 0, peak = 0;
+      i = 0;
+      const Image first = read_image(work + "/point0.fits");
+      std::vector<Image> points;
+      for (size_t k = 0; k < albedo.values.size() * g.values.size(); ++k)
+        points.push_back(read_image(work + "/point" + std::to_string(k) + ".fits"));
+      const std::vector<Image> cube = read_fits_cube(work + "/cube.fits");
+      if (cube.size() != points.size()) throw Error("bench sweep: the cube has " + std::to_string(cube.size()) + " points");
+      for (size_t k = 0; k < points.size(); ++k)
+        for (size_t p = 0; p < first.pixels.size(); ++p) {
+          worst = std::max(worst, double(std::fabs(cube[k].pixels[p] - points[k].pixels[p])));
+          peak = std::max(peak, double(points[k].pixels[p]));
+        }
+      const size_t n = points.size();
+      std::printf("\nsweep, %s%s: %s, %zu points (albedo x %zu, g x %zu), %d x %d\n", to_string(backend),
+                  backend == Backend::Cuda ? (" (" + gpu_description() + ")").c_str() : "", o->scene.c_str(), n,
+                  albedo.values.size(), g.values.size(), o->width, o->height);
+      std::printf("| tables made beforehand s | %zu separate renders s | one sweep s | s per point, separate | s per point, sweep | speed-up | max |cube - separate| / peak |\n"
+                  "|---|---|---|---|---|---|---|\n| %.1f | %.2f | %.2f | %.3f | %.3f | %.2f | %.3g |\n",
+                  n, tables, separate, sweep, separate / n, sweep / n, separate / sweep, peak > 0 ? worst / peak : 0.0);
+      std::fflush(stdout);
+    }
+  });
+}
 }  // namespace
 
 void add_bench_command(CLI::App& app) {
@@ -314,6 +395,8 @@ void add_bench_command(CLI::App& app) {
   add_truth(cmd);
   add_axial(cmd);
   add_frame_benchmarks(cmd);  // app/bench_frames.cpp: animate, viewer
+  add_sweep(cmd);
+  add_spectral_bench(cmd);
 }
 
 }  // namespace nebula::app

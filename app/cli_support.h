@@ -11,6 +11,7 @@
 #include <CLI/CLI.hpp>
 
 #include "core/backend.h"
+#include "imageio/image_output.h"
 #include "scene/scene.h"
 
 namespace nebula::app {
@@ -59,5 +60,9 @@ using OptionNames = std::map<std::string, std::string>;
 // Error("<context>: <parameter>: <reason>") when `context` (the scene file)
 // is given. Other errors pass unchanged.
 void naming_options(const OptionNames& options, const std::function<void()>& body, const std::string& context = "");
+
+// A sweep axis from "KEY=START:STOP:COUNT" or "KEY=V1,V2,..." (`nebula sweep
+// --grid`); Error naming --grid and the reason (app/sweep_command.cpp).
+CubeAxis parse_grid_axis(const std::string& spec);
 
 }  // namespace nebula::app

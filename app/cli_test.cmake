@@ -173,3 +173,25 @@ string(FIND "${out}" "| full | 90 | omega_multi | naive |" at)
 if(NOT rc EQUAL 0 OR at EQUAL -1)
   message(FATAL_ERROR "bench axial failed (${rc}): ${out} ${err}")
 endif()
+
+# Sweeps: a 2 x 2 albedo x g grid to a FITS cube (its shape and axes read back
+# by `nebula sweep` itself is not enough: python.module checks the pixels),
+# and the refusals, each before any work and with nothing written.
+file(WRITE ${WORK}/sweep.toml "[density]\nprocedural = { n = 12, size_pc = 2.0 }\n[[stars]]\nluminosity_lsun = 2e5\nclass = \"O5V\"\n[camera]\nposition = [1.0, -2.5, 1.0]\nlook_at = [1.0, 1.0, 1.0]\nwidth = 12\nheight = 10\n[render]\ndiffuse_photons = 16384\n")
+execute_process(COMMAND ${NEBULA} sweep sweep.toml --grid dust.albedo=0.3:0.9:2 --grid dust.g=0,0.6 -o sweep.fits
+                        --backend cpu --table-photons 1000 -q
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err WORKING_DIRECTORY ${WORK})
+string(FIND "${out}" "sweep: 4 points (dust.albedo x 2, dust.g x 2)" at)
+string(FIND "${out}" "star bakes 3 of 4" reused)
+if(NOT rc EQUAL 0 OR at EQUAL -1 OR reused EQUAL -1 OR NOT EXISTS ${WORK}/sweep.fits)
+  message(FATAL_ERROR "sweep failed (${rc}): ${out} ${err}")
+endif()
+set(sweep_ok sweep.toml --backend cpu --table-photons 1000 -q)
+expect_failure(sweep_key "dust.albdo" sweep ${sweep_ok} --grid dust.albdo=0.3,0.6 -o bad.fits)
+expect_failure(sweep_value "dust.albedo" sweep ${sweep_ok} --grid dust.albedo=0.3,1.5 -o bad.fits)
+expect_failure(sweep_empty "empty range" sweep ${sweep_ok} --grid dust.albedo=0.3:0.9:0 -o bad.fits)
+expect_failure(sweep_text "'x' is not a number" sweep ${sweep_ok} --grid dust.g=0,x -o bad.fits)
+expect_failure(sweep_form "KEY=START:STOP:COUNT" sweep ${sweep_ok} --grid dust.g -o bad.fits)
+expect_failure(sweep_twice "swept twice" sweep ${sweep_ok} --grid dust.g=0 --grid dust.g=0.3 -o bad.fits)
+expect_failure(sweep_large "--force" sweep ${sweep_ok} --grid dust.g=0:0.5:1000 --grid dust.albedo=0:1:1000 -o bad.fits)
+expect_failure(sweep_png "a cube is written as" sweep ${sweep_ok} --grid dust.g=0 -o bad.png)

@@ -64,11 +64,13 @@ int main(int argc, char** argv) {
   nebula::app::add_truth_command(app);
   nebula::app::add_animate_command(app);
   nebula::app::add_compare_command(app);
+  nebula::app::add_sweep_command(app);
   nebula::app::add_tabulate_command(app);
   nebula::app::add_table_command(app);
   nebula::app::add_slab_command(app);
   nebula::app::add_validate_command(app);
   nebula::app::add_bench_command(app);
+  nebula::app::add_filters_command(app);
   if (unknown_command(app, argc, argv)) return 2;
   try {
     app.parse(argc, argv);

@@ -23,6 +23,8 @@ void print_headline(const RunReport& r) {
     std::printf("grid %dx%dx%d, ", r.grid.nx, r.grid.ny, r.grid.nz);
     if (r.truth)
       std::printf("%d spp", r.truth->spp);
+    else if (r.spectral)
+      std::printf("%s", r.mode.c_str());
     else
       std::printf("%s traversal", r.mode == "exact" ? "exact" : "smooth");
   }
@@ -43,6 +45,7 @@ void print_multiple_scattering(const RunReport& r) {
                 "on %dx%dx%d cells of %d voxel(s); %.3g s (photon passes %.3g s); noise, relative L2 of its l = 0 part:",
                 d.bands, (unsigned long long)d.photons_per_band, d.order, d.cells.nx, d.cells.ny, d.cells.nz,
                 d.voxels_per_cell, d.wall_seconds, d.seconds);
+    if (d.reused) std::printf(" [reused: nothing it depends on changed; figures of its bake]");
   }
   if (d.done) {
     for (size_t b = 0; b < d.noise.size() && b < r.bands.size(); ++b)
@@ -58,7 +61,37 @@ void print_multiple_scattering(const RunReport& r) {
   if (r.pyramid.size() <= 1 && r.multiple_scattering == "pyramid") std::printf("  pyramid levels: none\n");
 }
 
+// The spectral renderer's model: filters, method, basis (docs/spectral.md).
+void print_spectral(const RunReport& r) {
+  const SpectralReport& s = *r.spectral;
+  std::printf("computed, and why:\n");
+  for (const SpectralFilterReport& f : s.filters)
+    std::printf("  filter %s: %.0f-%.0f nm, pivot %.1f nm, %d cubic segment(s), fit error %.2g of the peak\n",
+                f.name.c_str(), f.from_nm, f.to_nm, f.pivot_nm, f.segments, f.fit_error);
+  std::printf("  attenuation: %s over %.3f-%.3f um (%s law, R_V %g)\n",
+              s.attenuation == "inverse" ? "C_T / lambda (the report's)" : "the extinction law", s.lo_um, s.hi_um,
+              to_string(r.law), r.R_V);
+  if (s.method == "double") {
+    std::printf("  method: double integral, %d wavelength samples per voxel and star\n", s.wavelengths);
+  } else if (s.method == "analytic") {
+    std::printf("  method: analytic integral (exponential-integral recurrence) per voxel, star and filter\n");
+  } else {
+    std::printf("  method: %s, %d basis element(s) (%s norm) fitted on optical paths 0-%g, table to %g; elements a =",
+                s.method == "projection" ? "projection" : "light-density basis", s.basis, s.norm.c_str(), s.fit_depth,
+                s.max_depth);
+    for (double a : s.elements) std::printf(" %.3g", a);
+    std::printf("; largest family residual %.2g\n", s.basis_error);
+  }
+  std::printf("  %d number(s) per ray; model %.3g s, resolve %.3g s\n", s.accumulators, s.model_seconds,
+              s.resolve_seconds);
+  if (r.bake.done)
+    std::printf("  bake: %zu star(s) x %llu voxels, %g s\n", r.bake.stars, (unsigned long long)r.bake.cells,
+                r.bake.seconds);
+  std::printf("  single scattering per voxel (thin-voxel HG); no tables, no light between voxels, no emission\n");
+}
+
 void print_computed(const RunReport& r) {
+  if (r.spectral) return print_spectral(r);
   std::printf("computed, and why:\n");
   for (const BandReport& b : r.bands)
     std::printf("  band %s: A/A_V %.4f (%s law, R_V %g, Bessell passband), albedo %g, g %g%s\n", b.name.c_str(),
@@ -75,7 +108,10 @@ void print_computed(const RunReport& r) {
                 to_string(t.origin), t.path.c_str(), t.seconds);
   }
   if (r.truth) return;
-  if (r.bake.done)
+  if (r.bake.done && r.bake.reused)
+    std::printf("  bake: %zu star(s) x %llu voxels, reused (the grid and the stars' positions unchanged)\n",
+                r.bake.stars, (unsigned long long)r.bake.cells);
+  else if (r.bake.done)
     std::printf("  bake: %zu star(s)%s x %llu %s, %g s\n", r.bake.stars, r.axial ? " on the axis" : "",
                 (unsigned long long)r.bake.cells, r.axial ? "texels" : "voxels", r.bake.seconds);
   else
@@ -115,6 +151,10 @@ void print_report(const RunReport& r) {
                 (unsigned long long)t.counters.tentative, (unsigned long long)t.counters.capped);
     std::printf("  tracing %.3f s: %.3g vertices/s, %.3g paths/s, %.3g spp/s at this size; total %.2f s\n", s,
                 t.counters.vertices / s, t.paths / s, t.spp / s, r.total_seconds);
+    return;
+  }
+  if (r.spectral) {
+    std::printf("render: %.3f s marching; total %.2f s\n", r.render_seconds, r.total_seconds);
     return;
   }
   std::printf("render: %.3f s marching, %llu table lookups beyond tau_max (clamped); total %.2f s\n", r.render_seconds,

@@ -15,6 +15,10 @@ namespace nebula {
 // size in registers (DESIGN.md, "Band loops in kernels").
 constexpr int kMaxBands = 4;
 
+// The band of one-wavelength (grey) radiative transfer, as benchmarks use: no
+// filter, the star's whole luminosity, A/A_V = 1 (pipeline/scene_bands.h).
+inline constexpr const char* kGreyBand = "grey";
+
 // One band: its filter and the dust's optical properties in it.
 struct Band {
   std::string name;            // the filter's name, e.g. "V"

@@ -117,4 +117,44 @@ Camera coarser_camera(const Camera& c) {
   return out;
 }
 
+std::optional<ImagePoint> project_point(const Camera& c, Vec3 p) {
+  const double fw = c.frame_width > 0 ? c.frame_width : c.width;
+  const double fh = c.frame_height > 0 ? c.frame_height : c.height;
+  const double span = c.pixel_span;
+  const Vec3 d = p - c.position;
+  const double along = dot(d, c.forward), across = dot(d, c.right), upward = dot(d, c.up);
+  // Image coordinates u (-1 left .. 1 right) and v (1 top .. -1 bottom), and
+  // the size of a pixel in them.
+  double u = 0, v = 0, measure = 0;
+  const double du = 2.0 * span / fw, dv = 2.0 * span / fh;
+  if (c.projection == Projection::Perspective) {
+    if (!(along > 0)) return std::nullopt;
+    const double aspect = fw / fh, t = c.tan_half_fov;
+    u = across / along / (aspect * t);
+    v = upward / along / t;
+    // The tangent plane's pixel (du aspect t by dv t) seen at cos(theta) off axis.
+    const double cos_theta = along / std::sqrt(double(dot(d, d)));
+    measure = du * aspect * t * dv * t * cos_theta * cos_theta * cos_theta;
+  } else if (c.projection == Projection::Orthographic) {
+    if (!(along > 0)) return std::nullopt;
+    u = across / c.half_width;
+    v = upward / c.half_height;
+    measure = du * c.half_width * dv * c.half_height;
+  } else {
+    const double sideways = std::hypot(across, upward);
+    if (!(sideways > 0 || along > 0)) return std::nullopt;
+    // atan2, not acos: exact near the zenith.
+    const double theta = std::atan2(sideways, along);
+    if (theta > 0.5 * kPiD) return std::nullopt;
+    const double rho = theta / (0.5 * kPiD);
+    u = sideways > 0 ? rho * across / sideways : 0.0;
+    v = sideways > 0 ? rho * upward / sideways : 0.0;
+    // Equidistant: d(theta) = (pi/2) d(rho) and d(phi) = d(area) / (rho d(rho)),
+    // so a solid angle sin(theta) d(theta) d(phi) is (pi/2)^2 sin(theta)/theta d(area).
+    const double sinc = theta > 1e-8 ? std::sin(theta) / theta : 1.0;
+    measure = 0.25 * kPiD * kPiD * sinc * du * dv;
+  }
+  return ImagePoint{(u + 1.0) * 0.5 * fw / span, (1.0 - v) * 0.5 * fh / span, measure};
+}
+
 }  // namespace nebula

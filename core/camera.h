@@ -41,10 +41,16 @@ struct Camera {
   // The ray through the centre of pixel (px, py); false where the pixel shows
   // nothing (outside the dome circle of the fisheye).
   NEBULA_HD bool ray(int px, int py, Vec3& origin, Vec3& dir) const {
+    return ray_through(px + 0.5f, py + 0.5f, origin, dir);
+  }
+
+  // The ray through the image point (fx, fy) in pixels from the top-left
+  // corner (pixel (px, py) spans [px, px + 1) x [py, py + 1)).
+  NEBULA_HD bool ray_through(float fx, float fy, Vec3& origin, Vec3& dir) const {
     const float fw = float(frame_width > 0 ? frame_width : width);
     const float fh = float(frame_height > 0 ? frame_height : height);
-    const float u = 2.0f * (px + 0.5f) * pixel_span / fw - 1.0f;   // -1 left .. 1 right
-    const float v = 1.0f - 2.0f * (py + 0.5f) * pixel_span / fh;  // 1 top .. -1 bottom
+    const float u = 2.0f * fx * pixel_span / fw - 1.0f;   // -1 left .. 1 right
+    const float v = 1.0f - 2.0f * fy * pixel_span / fh;  // 1 top .. -1 bottom
     if (projection == Projection::Perspective) {
       const float aspect = fw / fh;
       origin = position;
@@ -121,6 +127,17 @@ Camera make_camera(const CameraSettings& s);
 // The same frame at half the resolution (ceil of each size): pixel i covers
 // pixels 2i and 2i + 1 of `c` (the pyramid's image levels).
 Camera coarser_camera(const Camera& c);
+
+// Where a point appears in the image, the inverse of Camera::ray_through:
+// (x, y) in pixels from the top-left corner, and the pixel's measure there:
+// its solid angle in sr (perspective, fisheye) or its area in world units
+// squared (orthographic). Nothing when the point is behind the camera (or its
+// image plane), or outside the fisheye's dome.
+struct ImagePoint {
+  double x = 0, y = 0;
+  double pixel_measure = 0;
+};
+std::optional<ImagePoint> project_point(const Camera& c, Vec3 p);
 
 // "perspective", "orthographic", "fisheye" (the scene file's camera.kind).
 const char* to_string(Projection p);

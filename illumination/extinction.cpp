@@ -37,7 +37,12 @@ void check_R_V(double R_V) {
 }  // namespace
 
 const char* to_string(ExtinctionLaw law) {
-  return law == ExtinctionLaw::CCM89 ? "CCM89" : "ODonnell94";
+  switch (law) {
+    case ExtinctionLaw::CCM89: return "CCM89";
+    case ExtinctionLaw::ODonnell94: return "ODonnell94";
+    case ExtinctionLaw::Grey: return "grey";
+  }
+  return "?";
 }
 
 ExtinctionCoefficients extinction_coefficients(double x, ExtinctionLaw law) {
@@ -52,6 +57,13 @@ ExtinctionCoefficients extinction_coefficients(double x, ExtinctionLaw law) {
     const double power = std::pow(x, 1.61);  // CCM 1989 infrared power law
     return {0.574 * power, -0.527 * power};
   }
+  if (x > 3.3) {  // CCM 1989 ultraviolet, with its far-UV curvature past x = 5.9
+    const double fy = x > 5.9 ? x - 5.9 : 0.0;
+    const double fa = -0.04473 * fy * fy - 0.009779 * fy * fy * fy;
+    const double fb = 0.2130 * fy * fy + 0.1207 * fy * fy * fy;
+    return {1.752 - 0.316 * x - 0.104 / ((x - 4.67) * (x - 4.67) + 0.341) + fa,
+            -3.090 + 1.825 * x + 1.206 / ((x - 4.62) * (x - 4.62) + 0.263) + fb};
+  }
   const double y = x - 1.82;
   if (law == ExtinctionLaw::ODonnell94) return {polynomial(kODonnellA, y), polynomial(kODonnellB, y)};
   return {polynomial(kCcmA, y), polynomial(kCcmB, y)};
@@ -61,6 +73,7 @@ double extinction_ratio_at(double wavelength_nm, double R_V, ExtinctionLaw law) 
   check_R_V(R_V);
   if (!(wavelength_nm > 0.0) || !std::isfinite(wavelength_nm))
     throw Error("wavelength " + to_text(wavelength_nm) + " nm is not a positive finite number");
+  if (law == ExtinctionLaw::Grey) return 1.0;
   const ExtinctionCoefficients c = extinction_coefficients(1000.0 / wavelength_nm, law);
   return c.a + c.b / R_V;
 }

@@ -228,6 +228,12 @@ class Reader {
 }  // namespace
 
 void write_fits(const Image& image, const ImageMetadata& metadata, const std::string& file_name) {
+  write_fits_cube({&image}, {}, metadata, file_name);
+}
+
+void write_fits_cube(const std::vector<const Image*>& images, const std::vector<CubeAxis>& cube_axes,
+                     const ImageMetadata& metadata, const std::string& file_name) {
+  const Image& image = *images.front();
   const std::lock_guard<std::mutex> lock(fits_mutex);
   // cfitsio creates the file itself and refuses one that exists. Its
   // "disk file" calls take the name literally, where the plain ones would
@@ -240,8 +246,11 @@ void write_fits(const Image& image, const ImageMetadata& metadata, const std::st
     fits.f = nullptr;
     throw Error("creating the FITS file (" + cfitsio_reason(status) + ")");
   }
-  long axes[3] = {image.width, image.height, static_cast<long>(image.bands.size())};
-  if (fits_create_img(fits.f, FLOAT_IMG, 3, axes, &status) != 0)
+  // NAXIS1..3 = width, height, bands; then the cube's axes, the last (the
+  // fastest varying) first, so that numpy's shape is (first axis, ..., bands, rows, columns).
+  std::vector<long> axes{image.width, image.height, static_cast<long>(image.bands.size())};
+  for (size_t k = cube_axes.size(); k-- > 0;) axes.push_back(static_cast<long>(cube_axes[k].values.size()));
+  if (fits_create_img(fits.f, FLOAT_IMG, static_cast<int>(axes.size()), axes.data(), &status) != 0)
     throw Error("creating the FITS image (" + cfitsio_reason(status) + ")");
 
   bool continued = false;
@@ -272,15 +281,17 @@ void write_fits(const Image& image, const ImageMetadata& metadata, const std::st
   // Plane by plane, top row last (FITS rows go up).
   const size_t width = image.width, plane = image.plane_size();
   std::vector<float> rows(plane);
-  for (size_t b = 0; b < image.bands.size(); ++b) {
-    for (int y = 0; y < image.height; ++y) {
-      const float* source = &image.pixels[b * plane + size_t(y) * width];
-      std::copy(source, source + width, rows.begin() + size_t(image.height - 1 - y) * width);
+  size_t first = 1;
+  for (const Image* each : images)
+    for (size_t b = 0; b < image.bands.size(); ++b, first += plane) {
+      for (int y = 0; y < image.height; ++y) {
+        const float* source = &each->pixels[b * plane + size_t(y) * width];
+        std::copy(source, source + width, rows.begin() + size_t(image.height - 1 - y) * width);
+      }
+      if (fits_write_img(fits.f, TFLOAT, static_cast<LONGLONG>(first), static_cast<LONGLONG>(plane), rows.data(),
+                         &status) != 0)
+        throw Error("writing the pixels (" + cfitsio_reason(status) + ")");
     }
-    if (fits_write_img(fits.f, TFLOAT, static_cast<LONGLONG>(b * plane + 1), static_cast<LONGLONG>(plane),
-                       rows.data(), &status) != 0)
-      throw Error("writing the pixels (" + cfitsio_reason(status) + ")");
-  }
   if (fits_write_chksum(fits.f, &status) != 0)
     throw Error("writing the checksums (" + cfitsio_reason(status) + ")");
 
@@ -294,6 +305,21 @@ void write_fits(const Image& image, const ImageMetadata& metadata, const std::st
                        const_cast<char*>(metadata.scene_text.data()), &status) != 0 ||
         fits_write_chksum(fits.f, &status) != 0)
       throw Error("writing the SCENE extension (" + cfitsio_reason(status) + ")");
+  }
+  // Each cube axis's values: a 1-D double image extension named by its key
+  // (astropy: hdul["dust.albedo"].data).
+  for (size_t k = 0; k < cube_axes.size(); ++k) {
+    const CubeAxis& axis = cube_axes[k];
+    long length[1] = {static_cast<long>(axis.values.size())};
+    const int number = static_cast<int>(3 + cube_axes.size() - k);
+    const std::string comment = "values along NAXIS" + std::to_string(number);
+    if (fits_create_img(fits.f, DOUBLE_IMG, 1, length, &status) != 0 ||
+        fits_write_key_str(fits.f, "EXTNAME", axis.key.c_str(), comment.c_str(), &status) != 0 ||
+        fits_write_key_lng(fits.f, "AXISNUM", number, "the primary image's axis these values label", &status) != 0 ||
+        fits_write_img(fits.f, TDOUBLE, 1, static_cast<LONGLONG>(axis.values.size()),
+                       const_cast<double*>(axis.values.data()), &status) != 0 ||
+        fits_write_chksum(fits.f, &status) != 0)
+      throw Error("writing the extension " + axis.key + " (" + cfitsio_reason(status) + ")");
   }
   fitsfile* f = fits.f;
   fits.f = nullptr;
@@ -405,6 +431,85 @@ Image read_fits(const std::string& path, ImageMetadata* metadata) {
   }
   *metadata = m;
   return image;
+}
+
+
+std::vector<Image> read_fits_cube_file(const std::string& path, std::vector<CubeAxis>* cube_axes) {
+  const std::lock_guard<std::mutex> lock(fits_mutex);
+  FitsFile fits;
+  int status = 0;
+  if (fits_open_diskfile(&fits.f, path.c_str(), READONLY, &status) != 0) {
+    fits.f = nullptr;
+    throw Error(path + ": cannot open as FITS (" + cfitsio_reason(status) + "); expected a nebula cube");
+  }
+  const Reader r(path, fits.f);
+  int bitpix = 0, naxis = 0;
+  long axes[9] = {0};
+  if (fits_get_img_param(fits.f, 9, &bitpix, &naxis, axes, &status) != 0)
+    fail(path, "primary HDU", "an image", cfitsio_reason(status));
+  if (naxis < 3 || naxis > 9) fail(path, "NAXIS", "3 to 9 (width, height, bands, the cube's axes)", std::to_string(naxis));
+  size_t count = 1;
+  for (int k = 0; k < naxis; ++k) {
+    if (axes[k] <= 0 || size_t(axes[k]) > kMaxElements / count)
+      fail(path, "NAXIS" + std::to_string(k + 1), "a cube of 1 to 2^29 values", std::to_string(axes[k]));
+    count *= size_t(axes[k]);
+  }
+  int data_ok = 0, header_ok = 0;
+  if (fits_verify_chksum(fits.f, &data_ok, &header_ok, &status) != 0 || data_ok < 0 || header_ok < 0)
+    fail(path, "CHECKSUM", "matching checksums", "a mismatch (damaged file?)");
+  Image shape;
+  shape.width = static_cast<int>(axes[0]);
+  shape.height = static_cast<int>(axes[1]);
+  for (long b = 1; b <= axes[2]; ++b) shape.bands.push_back(r.string_key("BAND" + std::to_string(b), "a band name"));
+  std::vector<float> all(count);
+  int any_null = 0;
+  float no_null = 0;
+  if (fits_read_img(fits.f, TFLOAT, 1, static_cast<LONGLONG>(count), &no_null, all.data(), &any_null, &status) != 0)
+    fail(path, "data", "readable pixels", cfitsio_reason(status));
+  const size_t width = shape.width, plane = size_t(shape.width) * shape.height, per_image = plane * shape.bands.size();
+  std::vector<Image> images(count / per_image, shape);
+  for (size_t i = 0; i < images.size(); ++i) {
+    images[i].pixels.resize(per_image);
+    for (size_t b = 0; b < shape.bands.size(); ++b)
+      for (int y = 0; y < shape.height; ++y) {  // FITS rows go up
+        const float* row = &all[i * per_image + b * plane + size_t(shape.height - 1 - y) * width];
+        std::copy(row, row + width, images[i].pixels.begin() + b * plane + size_t(y) * width);
+      }
+  }
+  if (cube_axes) {
+    cube_axes->clear();
+    for (int k = naxis; k > 3; --k) {  // the first axis is the last FITS axis; keys from the extensions
+      cube_axes->push_back({"", {}});
+      cube_axes->back().values.resize(size_t(axes[k - 1]));
+    }
+    int hdus = 0;
+    if (fits_get_num_hdus(fits.f, &hdus, &status) != 0) fail(path, "HDUs", "a readable file", cfitsio_reason(status));
+    for (int h = 2; h <= hdus; ++h) {
+      if (fits_movabs_hdu(fits.f, h, nullptr, &status) != 0)
+        fail(path, "HDU " + std::to_string(h), "a readable extension", cfitsio_reason(status));
+      long number = 0;
+      if (fits_read_key_lng(fits.f, "AXISNUM", &number, nullptr, &status) != 0) {
+        status = 0;
+        fits_clear_errmsg();
+        continue;
+      }
+      if (number < 4 || number > naxis) fail(path, "AXISNUM", "4 to NAXIS", std::to_string(number));
+      CubeAxis& axis = (*cube_axes)[size_t(naxis - number)];
+      char extname[FLEN_VALUE] = {0};
+      if (fits_read_key_str(fits.f, "EXTNAME", extname, nullptr, &status) != 0)
+        fail(path, "EXTNAME", "the key of axis " + std::to_string(number), cfitsio_reason(status));
+      axis.key = extname;
+      std::vector<double>& values = axis.values;
+      double none = 0;
+      if (fits_read_img(fits.f, TDOUBLE, 1, static_cast<LONGLONG>(values.size()), &none, values.data(), &any_null,
+                        &status) != 0)
+        fail(path, "AXIS" + std::to_string(number), "the axis's values", cfitsio_reason(status));
+    }
+  }
+  if (cube_axes)
+    for (const CubeAxis& a : *cube_axes)
+      if (a.key.empty()) fail(path, "extensions", "one per cube axis (AXISNUM, EXTNAME)", "an axis without one");
+  return images;
 }
 
 }  // namespace nebula::imageio_detail

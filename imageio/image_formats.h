@@ -17,12 +17,18 @@ void write_hdf5(const Image& image, const ImageMetadata& metadata, const std::st
 void write_fits(const Image& image, const ImageMetadata& metadata, const std::string& file);
 void write_exr(const Image& image, const ImageMetadata& metadata, const std::string& file);
 void write_png(const Image& image, const ImageMetadata& metadata, const std::string& file);
+// Cubes (write_cube): the images one after another, first axis slowest.
+void write_hdf5_cube(const std::vector<const Image*>& images, const std::vector<CubeAxis>& axes,
+                     const ImageMetadata& metadata, const std::string& file);
+void write_fits_cube(const std::vector<const Image*>& images, const std::vector<CubeAxis>& axes,
+                     const ImageMetadata& metadata, const std::string& file);
 
 // Readers get an existing regular file and throw Error starting "PATH: ".
 // read_image then checks the band names and that every pixel is finite.
 Image read_hdf5(const std::string& path, ImageMetadata* metadata);
 Image read_fits(const std::string& path, ImageMetadata* metadata);
 Image read_exr(const std::string& path, ImageMetadata* metadata);
+std::vector<Image> read_fits_cube_file(const std::string& path, std::vector<CubeAxis>* axes);
 
 // The most floats a reader allocates (2 GiB): a malformed header claiming
 // more is refused instead of exhausting memory.

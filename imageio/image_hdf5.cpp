@@ -204,8 +204,14 @@ std::vector<std::string> attribute_names(const std::string& path, hid_t file) {
 }  // namespace
 
 void write_hdf5(const Image& image, const ImageMetadata& metadata, const std::string& file_name) {
+  write_hdf5_cube({&image}, {}, metadata, file_name);
+}
+
+void write_hdf5_cube(const std::vector<const Image*>& images, const std::vector<CubeAxis>& cube_axes,
+                     const ImageMetadata& metadata, const std::string& file_name) {
   const std::lock_guard<std::mutex> lock(hdf5io::hdf5_mutex());
   hdf5io::silence_hdf5_errors();
+  const Image& image = *images.front();
 
   // The core driver builds the file in memory and writes it out on close:
   // HDF5 1.10 recovers from a failed write there (tables/table_file.cpp has
@@ -213,7 +219,7 @@ void write_hdf5(const Image& image, const ImageMetadata& metadata, const std::st
   // metadata, the chunk index included; the 1.8 format's chunk index has
   // no checksum, and a damaged one there passed pixels off as unfiltered.
   // Tracking creation order keeps the metadata entries in the order given.
-  const size_t bytes = image.pixels.size() * sizeof(float);
+  const size_t bytes = image.pixels.size() * sizeof(float) * images.size();
   Handle access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
   Handle creation(H5Pcreate(H5P_FILE_CREATE), H5Pclose);
   if (!access.valid() || !creation.valid() ||
@@ -225,21 +231,54 @@ void write_hdf5(const Image& image, const ImageMetadata& metadata, const std::st
   if (!file.valid()) throw Error(with_reason("creating the HDF5 file"));
   const hid_t f = file.get();
 
-  const hsize_t dims[3] = {image.bands.size(), hsize_t(image.height), hsize_t(image.width)};
-  Handle space(H5Screate_simple(3, dims, nullptr), H5Sclose);
+  // [axis 1, ..., axis K,] bands, rows, columns.
+  std::vector<hsize_t> dims;
+  for (const CubeAxis& a : cube_axes) dims.push_back(a.values.size());
+  dims.insert(dims.end(), {hsize_t(image.bands.size()), hsize_t(image.height), hsize_t(image.width)});
+  const int rank = static_cast<int>(dims.size());
+  Handle space(H5Screate_simple(rank, dims.data(), nullptr), H5Sclose);
   if (!space.valid()) throw Error(with_reason("creating the dataspace of /image"));
   // One chunk per band, each with a Fletcher-32 checksum: damaged pixels
   // are refused on reading, as damaged metadata are.
-  const hsize_t chunk[3] = {1, dims[1], dims[2]};
+  std::vector<hsize_t> chunk(dims.size(), 1);
+  chunk[rank - 2] = dims[rank - 2];
+  chunk[rank - 1] = dims[rank - 1];
   Handle layout(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
-  if (!layout.valid() || H5Pset_chunk(layout.get(), 3, chunk) < 0 || H5Pset_fletcher32(layout.get()) < 0)
+  if (!layout.valid() || H5Pset_chunk(layout.get(), rank, chunk.data()) < 0 || H5Pset_fletcher32(layout.get()) < 0)
     throw Error(with_reason("setting up the layout of /image"));
   Handle set(H5Dcreate2(f, "/image", H5T_IEEE_F32LE, space.get(), H5P_DEFAULT, layout.get(), H5P_DEFAULT),
              H5Dclose);
   if (!set.valid()) throw Error(with_reason("creating /image"));
-  if (H5Dwrite(set.get(), H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, image.pixels.data()) < 0)
+  std::vector<float> all;
+  const std::vector<float>* pixels = &image.pixels;
+  if (images.size() > 1) {
+    all.reserve(image.pixels.size() * images.size());
+    for (const Image* each : images) all.insert(all.end(), each->pixels.begin(), each->pixels.end());
+    pixels = &all;
+  }
+  if (H5Dwrite(set.get(), H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, pixels->data()) < 0)
     throw Error(with_reason("writing /image"));
   if (!set.close()) throw Error(with_reason("closing /image"));
+  // The cube's axes: /axes/<key> holds each one's values, the root
+  // attribute "axes" their keys in the order of /image's leading dimensions.
+  if (!cube_axes.empty()) {
+    Handle group(H5Gcreate2(f, "/axes", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+    if (!group.valid()) throw Error(with_reason("creating /axes"));
+    std::vector<std::string> keys;
+    for (const CubeAxis& a : cube_axes) {
+      keys.push_back(a.key);
+      const hsize_t n = a.values.size();
+      Handle line(H5Screate_simple(1, &n, nullptr), H5Sclose);
+      Handle values(H5Dcreate2(group.get(), a.key.c_str(), H5T_IEEE_F64LE, line.get(), H5P_DEFAULT, H5P_DEFAULT,
+                               H5P_DEFAULT),
+                    H5Dclose);
+      if (!line.valid() || !values.valid() ||
+          H5Dwrite(values.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, a.values.data()) < 0 ||
+          !values.close())
+        throw Error(with_reason("writing /axes/" + a.key));
+    }
+    write_string_array(f, "axes", keys);
+  }
 
   const int schema = kSchemaVersion;
   write_scalar(f, kSchemaName, H5T_STD_I32LE, H5T_NATIVE_INT, &schema);

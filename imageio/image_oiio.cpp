@@ -134,32 +134,28 @@ void write_exr(const Image& image, const ImageMetadata& metadata, const std::str
 }
 
 void write_png(const Image& image, const ImageMetadata& metadata, const std::string& file_name) {
-  // Red, green, blue from R, V, B; one grey channel from a single band.
-  std::vector<int> source;
-  if (image.bands.size() == 1) {
-    source = {0};
-  } else {
-    for (const char* band : {"R", "V", "B"})
-      source.push_back(static_cast<int>(
-          std::find(image.bands.begin(), image.bands.end(), band) - image.bands.begin()));
-  }
-  const int channels = static_cast<int>(source.size());
+  // Grey from a single band, else red, green, blue as weighted sums of the
+  // bands (png_colours: R, V, B themselves, or hues by pivot wavelength).
+  const std::vector<PngColour> colours = png_colours(image, metadata);
+  const int channels = image.bands.size() == 1 ? 1 : 3;
   OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::UINT8);
   spec.attribute("oiio:ColorSpace", "sRGB");
   spec.attribute(kPrefix + kBandsName, join_bands(image.bands));
   const DisplaySettings& display = metadata.display;
-  // Auto exposure looks at the bands shown only.
-  double exposure = metadata.exposure;
+  // The channels shown (weighted sums of the bands), then the display transform;
+  // auto exposure looks at the channels shown.
   const size_t plane = image.plane_size();
-  if (display.auto_exposure) {
-    std::vector<float> shown;
-    shown.reserve(plane * channels);
-    for (int c = 0; c < channels; ++c)
-      if (source[c] < int(image.bands.size()))
-        shown.insert(shown.end(), image.pixels.begin() + std::ptrdiff_t(source[c] * plane),
-                     image.pixels.begin() + std::ptrdiff_t((source[c] + 1) * plane));
-    exposure = auto_exposure_of(shown, display, metadata.exposure);
-  }
+  std::vector<float> shown(plane * size_t(channels));
+  for (size_t i = 0; i < plane; ++i)
+    for (int c = 0; c < channels; ++c) {
+      float v = 0.0f;
+      for (size_t b = 0; b < colours.size(); ++b) {
+        const PngColour& w = colours[b];
+        v += (c == 0 ? w.red : c == 1 ? w.green : w.blue) * image.pixels[b * plane + i];
+      }
+      shown[size_t(c) * plane + i] = v;
+    }
+  const double exposure = display.auto_exposure ? auto_exposure_of(shown, display, metadata.exposure) : metadata.exposure;
   spec.attribute("nebula:tone_map", std::string(to_string(display.stretch)) + " stretch of value x exposure " +
                                         exact_text(exposure) + (display.auto_exposure ? " (auto)" : "") +
                                         " / white " + exact_text(display.white) + ", softening " +
@@ -168,7 +164,7 @@ void write_png(const Image& image, const ImageMetadata& metadata, const std::str
   std::vector<uint8_t> levels(plane * channels);
   for (size_t i = 0; i < plane; ++i)
     for (int c = 0; c < channels; ++c)
-      levels[i * channels + c] = display_level(image.pixels[source[c] * plane + i], exposure, display);
+      levels[i * channels + c] = display_level(shown[size_t(c) * plane + i], exposure, display);
   write_with("png", spec, OIIO::TypeDesc::UINT8, levels.data(), file_name);
 }
 

@@ -142,7 +142,7 @@ std::string quoted(const std::string& text) {
   return out + "'";
 }
 
-void check_image(const Image& image, const std::string& path, Format format) {
+void check_image(const Image& image, const std::string& path, Format) {
   const std::string where = "cannot write " + path + ": ";
   if (image.width <= 0 || image.height <= 0)
     throw Error(where + "the image is " + std::to_string(image.width) + " x " +
@@ -160,10 +160,6 @@ void check_image(const Image& image, const std::string& path, Format format) {
       throw Error(where + "band name " + quoted(band) + " is not 1 to 32 characters of [A-Za-z0-9_.+-]");
     if (!seen.insert(band).second) throw Error(where + "band " + band + " appears twice");
   }
-  if (format == Format::Png && image.bands.size() != 1 &&
-      seen != std::set<std::string>{"B", "V", "R"})
-    throw Error(where + "PNG needs bands B, V, R (shown as blue, green, red) or a single band "
-                "(grey); this image has " + join_bands(image.bands));
 
   // Finite and non-negative: a NaN or a negative radiance is a bug upstream,
   // and a file is the worst place to discover it.
@@ -229,6 +225,56 @@ void check_image_format(const std::string& path) {
                 "-DNEBULA_OPENIMAGEIO=ON), use .h5 or .fits");
 }
 
+std::vector<PngColour> png_colours(const Image& image, const ImageMetadata& metadata) {
+  const size_t n = image.bands.size();
+  if (n == 1) return {PngColour{1, 1, 1}};
+  std::vector<PngColour> out(n);
+  if (std::set<std::string>(image.bands.begin(), image.bands.end()) == std::set<std::string>{"B", "V", "R"}) {
+    for (size_t b = 0; b < n; ++b)
+      out[b] = image.bands[b] == "R" ? PngColour{1, 0, 0} : image.bands[b] == "V" ? PngColour{0, 1, 0} : PngColour{0, 0, 1};
+    return out;
+  }
+  std::vector<std::pair<double, size_t>> pivots;
+  for (size_t b = 0; b < n; ++b) {
+    // pivot_nm_<band>, or pivot_nm_b<plane> for a long band name (docs/image_files.md).
+    const auto at = std::find_if(metadata.entries.begin(), metadata.entries.end(), [&](const auto& e) {
+      return e.first == "pivot_nm_" + image.bands[b] || e.first == "pivot_nm_b" + std::to_string(b + 1);
+    });
+    if (at == metadata.entries.end() || !at->second.is_number() || !(at->second.number() > 0))
+      throw Error("PNG needs bands B, V, R (shown as blue, green, red), a single band (grey), or a pivot "
+                  "wavelength for every band (metadata pivot_nm_<band>) to colour them by; band " +
+                  image.bands[b] + " of " + join_bands(image.bands) + " has none");
+    pivots.push_back({at->second.number(), b});
+  }
+  std::sort(pivots.begin(), pivots.end());
+  if (n == 2) {
+    out[pivots[0].second] = {0.0f, 0.5f, 1.0f};
+    out[pivots[1].second] = {1.0f, 0.5f, 0.0f};
+    return out;
+  }
+  // Hue from 240 degrees (blue) for the shortest pivot down to 0 (red) for the
+  // longest, on the piecewise-linear colour wheel (60 degrees per primary step).
+  float sum[3] = {0, 0, 0};
+  for (size_t r = 0; r < n; ++r) {
+    const double hue = 240.0 * (1.0 - double(r) / double(n - 1));
+    const auto ramp = [&](double centre) {
+      const double d = std::fabs(hue - centre);
+      return float(std::clamp(2.0 - d / 60.0, 0.0, 1.0));
+    };
+    PngColour c{ramp(0.0), ramp(120.0), ramp(240.0)};
+    out[pivots[r].second] = c;
+    sum[0] += c.red;
+    sum[1] += c.green;
+    sum[2] += c.blue;
+  }
+  for (PngColour& c : out) {
+    c.red /= sum[0];
+    c.green /= sum[1];
+    c.blue /= sum[2];
+  }
+  return out;
+}
+
 void write_image(const Image& image, const std::string& path, const ImageMetadata& metadata,
                  bool overwrite) {
   check_image_format(path);
@@ -236,6 +282,13 @@ void write_image(const Image& image, const std::string& path, const ImageMetadat
   format_of(path, format);
   check_image(image, path, format);
   check_metadata(metadata, path);
+  if (format == Format::Png) {
+    try {
+      png_colours(image, metadata);
+    } catch (const Error& e) {
+      throw Error("cannot write " + path + ": " + e.what());
+    }
+  }
   check_output_target(path, overwrite, "folder", true);
 
   TemporaryFile temporary(path);
@@ -252,6 +305,53 @@ void write_image(const Image& image, const std::string& path, const ImageMetadat
     throw Error("cannot write " + path + ": out of memory");
   }
   temporary.publish();
+}
+
+void write_cube(const std::vector<Image>& images, const std::vector<CubeAxis>& axes, const std::string& path,
+                const ImageMetadata& metadata, bool overwrite) {
+  check_image_format(path);
+  Format format{};
+  format_of(path, format);
+  if (format != Format::Fits && format != Format::Hdf5)
+    throw Error("cannot write " + path + ": a cube is written as .fits, .fit or .h5");
+  size_t points = 1;
+  for (const CubeAxis& a : axes) {
+    if (a.values.empty()) throw Error("cannot write " + path + ": the axis " + a.key + " has no values");
+    points *= a.values.size();
+  }
+  if (images.empty() || images.size() != points)
+    throw Error("cannot write " + path + ": " + std::to_string(images.size()) + " images for " +
+                std::to_string(points) + " grid points");
+  for (const Image& image : images) {
+    if (image.width != images.front().width || image.height != images.front().height ||
+        image.bands != images.front().bands)
+      throw Error("cannot write " + path + ": the cube's images differ in size or bands");
+    check_image(image, path, format);
+  }
+  if (double(images.front().pixels.size()) * double(images.size()) > double(kMaxElements))
+    throw Error("cannot write " + path + ": the cube holds more than 2^29 values (the readers' limit)");
+  check_metadata(metadata, path);
+  check_output_target(path, overwrite, "folder", true);
+  std::vector<const Image*> list;
+  for (const Image& image : images) list.push_back(&image);
+  TemporaryFile temporary(path);
+  try {
+    if (format == Format::Fits)
+      write_fits_cube(list, axes, metadata, temporary.path());
+    else
+      write_hdf5_cube(list, axes, metadata, temporary.path());
+  } catch (const Error& e) {
+    throw Error("cannot write " + path + ": " + e.what());
+  } catch (const std::bad_alloc&) {
+    throw Error("cannot write " + path + ": out of memory");
+  }
+  temporary.publish();
+}
+
+std::vector<Image> read_fits_cube(const std::string& path, std::vector<CubeAxis>* axes) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) throw Error(path + ": cannot read: no such file");
+  return read_fits_cube_file(path, axes);
 }
 
 Image read_image(const std::string& path, ImageMetadata* metadata) {

@@ -77,6 +77,27 @@ struct ImageMetadata {
 void write_image(const Image& image, const std::string& path, const ImageMetadata& metadata,
                  bool overwrite);
 
+// A cube of images over a grid of parameters (`nebula sweep`): one image per
+// grid point, all of one size and bands, the first axis varying slowest.
+struct CubeAxis {
+  std::string key;             // e.g. "dust.albedo"
+  std::vector<double> values;  // along the axis
+};
+
+// Writes the cube to PATH, .fits/.fit or .h5, with write_image's checks and
+// atomic replacement. FITS: NAXIS = 3 + K, NAXIS1..3 the image's width,
+// height and bands, then the axes last to first (numpy's shape: (first axis,
+// ..., bands, rows, columns)), and one 1-D extension per axis named by its
+// key holding its values. HDF5: /image of shape (axes..., bands, rows,
+// columns), /axes/<key> the values, root attribute "axes" the keys in order.
+// The metadata is the whole cube's (what all points share).
+void write_cube(const std::vector<Image>& images, const std::vector<CubeAxis>& axes, const std::string& path,
+                const ImageMetadata& metadata, bool overwrite);
+
+// Reads a FITS cube written by write_cube: the images, first axis slowest,
+// and the axes with their values. Errors name the file and the field.
+std::vector<Image> read_fits_cube(const std::string& path, std::vector<CubeAxis>* axes = nullptr);
+
 // write_image's first check, for callers that refuse a path before any work:
 // an unknown extension, or .exr/.png in a build without OpenImageIO.
 void check_image_format(const std::string& path);
@@ -94,6 +115,19 @@ Image read_image(const std::string& path, ImageMetadata* metadata = nullptr);
 // one line naming the file: a build without OpenImageIO, an unreadable or
 // deep or 3-D image, non-finite values.
 Image read_any_image(const std::string& path);
+
+// How a PNG shows an image's bands (docs/image_files.md, "PNG"): per band, the
+// weights of its plane in red, green and blue. One band: grey. Bands B, V, R:
+// red, green, blue from R, V, B. Otherwise every band needs a pivot wavelength
+// in the metadata (entry pivot_nm_<band>, as rendered images carry): the bands
+// ranked by pivot take hues from blue (the shortest) to red (the longest),
+// evenly by rank; with two bands, blue and red, and green their mean. Each
+// channel's weights sum to 1, so equal planes show grey. Error (one line, the
+// bands named) when neither rule applies.
+struct PngColour {
+  float red = 0, green = 0, blue = 0;
+};
+std::vector<PngColour> png_colours(const Image& image, const ImageMetadata& metadata);
 
 // Where the variance of an image lives (the ground truth writes one beside its
 // image; comparisons look for it): "out.h5" -> "out.var.h5".

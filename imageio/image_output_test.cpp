@@ -125,6 +125,55 @@ TEST_F(ImageFile, Hdf5RoundTripIsExact) {
   EXPECT_EQ(files(), std::vector<std::string>{"a.h5"});  // no temporary left
 }
 
+// A 3 x 2 cube: each point's image distinct (scaled), read back point by
+// point with its axes; HDF5 with /image of shape (3, 2, bands, rows, columns)
+// and the axes' values.
+TEST_F(ImageFile, CubesRoundTripWithTheirAxes) {
+  std::vector<Image> images;
+  for (int k = 0; k < 6; ++k) {
+    Image image = make_image(7, 5);
+    for (float& v : image.pixels) v = v / float(k + 1) + float(k);
+    images.push_back(image);
+  }
+  const std::vector<CubeAxis> axes{{"dust.albedo", {0.3, 0.6, 0.9}}, {"dust.g", {0.0, 0.75}}};
+  write_cube(images, axes, path("c.fits"), make_metadata(), false);
+  std::vector<CubeAxis> read_axes;
+  const std::vector<Image> back = read_fits_cube(path("c.fits"), &read_axes);
+  ASSERT_EQ(back.size(), 6u);
+  for (int k = 0; k < 6; ++k) expect_same_bits(images[k], back[k]);
+  ASSERT_EQ(read_axes.size(), 2u);
+  for (int a = 0; a < 2; ++a) {
+    EXPECT_EQ(read_axes[a].key, axes[a].key);
+    EXPECT_EQ(read_axes[a].values, axes[a].values);
+  }
+  write_cube(images, axes, path("c.h5"), make_metadata(), false);
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  const hid_t file = H5Fopen(path("c.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  const hid_t set = H5Dopen2(file, "/image", H5P_DEFAULT);
+  const hid_t space = H5Dget_space(set);
+  hsize_t dims[5] = {0};
+  ASSERT_EQ(H5Sget_simple_extent_ndims(space), 5);
+  H5Sget_simple_extent_dims(space, dims, nullptr);
+  EXPECT_EQ((std::vector<hsize_t>(dims, dims + 5)), (std::vector<hsize_t>{3, 2, 3, 5, 7}));
+  std::vector<float> all(3 * 2 * 3 * 5 * 7);
+  ASSERT_GE(H5Dread(set, H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, all.data()), 0);
+  EXPECT_EQ(std::vector<float>(all.begin() + 5 * 105, all.begin() + 6 * 105), images[5].pixels);
+  const hid_t g = H5Dopen2(file, "/axes/dust.g", H5P_DEFAULT);
+  double values[2] = {0, 0};
+  ASSERT_GE(H5Dread(g, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values), 0);
+  EXPECT_EQ(values[1], 0.75);
+  H5Dclose(g);
+  H5Sclose(space);
+  H5Dclose(set);
+  H5Fclose(file);
+  // Refusals: too few images, an empty axis, a PNG.
+  EXPECT_THROW(write_cube({images[0]}, axes, path("d.fits"), make_metadata(), false), Error);
+  EXPECT_THROW(write_cube(images, {{"dust.g", {}}}, path("d.fits"), make_metadata(), false), Error);
+  EXPECT_THROW(write_cube(images, axes, path("d.png"), make_metadata(), false), Error);
+  EXPECT_FALSE(std::filesystem::exists(path("d.fits")));
+}
+
 TEST_F(ImageFile, Hdf5LayoutAsDocumented) {
   const Image image = make_image(7, 5);
   write_image(image, path("a.h5"), make_metadata(), false);
@@ -391,6 +440,46 @@ TEST_F(ImageFile, PngNeedsBvrOrOneBand) {
   expect_error([&] { write_image(make_image(2, 2, {"B", "V", "I"}), path("a.png"), {}, false); },
                {"cannot write " + path("a.png"), "B,V,I"});
   EXPECT_TRUE(files().empty());
+}
+
+// Bands other than B, V, R are coloured by their pivot wavelengths
+// (pivot_nm_<band>, or pivot_nm_b<plane> for long names): blue to red by rank,
+// each channel's weights summing to 1; B, V, R themselves are unchanged.
+TEST(PngColours, ByPivotWavelength) {
+  const auto near = [](const PngColour& c, float r, float g, float b) {
+    EXPECT_NEAR(c.red, r, 1e-6f);
+    EXPECT_NEAR(c.green, g, 1e-6f);
+    EXPECT_NEAR(c.blue, b, 1e-6f);
+  };
+  ImageMetadata m;
+  const std::vector<PngColour> bvr = png_colours(make_image(1, 1, {"V", "R", "B"}), m);
+  near(bvr[0], 0, 1, 0);
+  near(bvr[1], 1, 0, 0);
+  near(bvr[2], 0, 0, 1);
+  near(png_colours(make_image(1, 1, {"F606W"}), m)[0], 1, 1, 1);
+  // Three bands in any order: the shortest pivot blue, the middle green, the longest red.
+  m.entries = {{"pivot_nm_i", 760.0}, {"pivot_nm_b2", 470.0}, {"pivot_nm_r", 620.0}};
+  const std::vector<PngColour> gri = png_colours(make_image(1, 1, {"i", "sdss_g", "r"}), m);
+  near(gri[0], 1, 0, 0);
+  near(gri[1], 0, 0, 1);
+  near(gri[2], 0, 1, 0);
+  // Two: blue and red, green their mean.
+  m.entries = {{"pivot_nm_x", 500.0}, {"pivot_nm_y", 400.0}};
+  const std::vector<PngColour> two = png_colours(make_image(1, 1, {"x", "y"}), m);
+  near(two[0], 1, 0.5f, 0);
+  near(two[1], 0, 0.5f, 1);
+  // Five: hues 240, 180, 120, 60, 0 degrees; every channel sums to 1, so equal planes are grey.
+  m.entries = {{"pivot_nm_a", 1.0}, {"pivot_nm_c", 2.0}, {"pivot_nm_d", 3.0}, {"pivot_nm_e", 4.0}, {"pivot_nm_f", 5.0}};
+  const std::vector<PngColour> five = png_colours(make_image(1, 1, {"a", "c", "d", "e", "f"}), m);
+  float sum[3] = {0, 0, 0};
+  for (const PngColour& c : five) {
+    sum[0] += c.red;
+    sum[1] += c.green;
+    sum[2] += c.blue;
+  }
+  for (float v : sum) EXPECT_NEAR(v, 1.0f, 1e-6f);
+  near(five[1], 0, 1.0f / 3, 0.5f);  // cyan: green and blue
+  expect_error([&] { png_colours(make_image(1, 1, {"a", "g"}), m); }, {"pivot", "band g"});
 }
 
 TEST(ToneMap, CurveAndLevels) {

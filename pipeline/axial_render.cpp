@@ -28,7 +28,7 @@ RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
   check_run_memory(scene, RunKind::Fast);
   const AxialSpec& spec = *scene.axial;
   const AxialSkip skip = parse_axial_skip(spec.skip, scene.path + ": axial.skip");
-  const Camera camera = make_camera(scene.camera);
+  (void)make_camera(scene.camera);  // the camera's errors before any work
   const size_t n_bands = scene.bands.size();
 
   const auto t_map = std::chrono::steady_clock::now();
@@ -101,15 +101,15 @@ RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
   }
   if (any)
     for (size_t k = 0; k < star_x.size(); ++k) in.stars.push_back(BakedStar{sb.stars[k], &bake.tau_v[k]});
-  in.camera = camera;
+  in.camera = make_camera(supersampled_camera(scene.camera, scene.samples_per_pixel));
   in.exposure = 1.0f;  // science pixels: the exposure goes in the metadata
   in.step = static_cast<float>(spec.step_texels * map.texel);
   in.skip = skip;
   AxialRenderStats stats;
   std::unique_ptr<Progress> bar;
-  if (o.progress && o.backend == Backend::Cpu) bar = std::make_unique<Progress>("render", uint64_t(camera.height));
+  if (o.progress && o.backend == Backend::Cpu) bar = std::make_unique<Progress>("render", uint64_t(in.camera.height));
   in.progress = bar.get();
-  out.image = render_axial(in, o.backend, &stats);
+  out.image = box_downsample(render_axial(in, o.backend, &stats), samples_per_pixel_side(scene.samples_per_pixel));
   if (bar) bar->finish();
   for (float v : out.image.pixels)
     if (!std::isfinite(v)) throw Error("axial render: a non-finite pixel (a bug: please report the scene)");
@@ -121,6 +121,7 @@ RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
   report.table_clamps = stats.table_clamps;
   out.metadata = scene_metadata(scene, sb, scene.camera, report.mode);
   out.metadata.entries.push_back({"multiple_scattering", multiple_scattering_text(report)});
+  out.metadata.entries.push_back({"pixel_samples", scene.samples_per_pixel});
   return out;
 }
 
@@ -129,7 +130,9 @@ RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
 RenderOutput render_scene(const Scene& scene, const RenderOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   RenderOutput out =
-      scene.axial ? render_axial_scene(scene, options) : render_prepared(prepare_grid(scene, options), scene.camera);
+      scene.spectral ? render_spectral_scene(scene, options)
+      : scene.axial  ? render_axial_scene(scene, options)
+                     : render_prepared(prepare_grid(scene, options), scene.camera);
   out.report.total_seconds = seconds_since(start);
   return out;
 }

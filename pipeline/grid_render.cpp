@@ -22,9 +22,45 @@ std::string mode_of(const RenderOptions& o) {
   return o.smooth_step > 0 ? "smooth step " + to_text(o.smooth_step) + " voxel" : "exact";
 }
 
+// Exact text of a float, so equal keys mean equal inputs.
+std::string exact(double v) { return to_text(v); }
+
+// What the star bakes depend on: the grid (by what it was made from; a scene
+// built in code has no such text and never reuses) and the stars' positions.
+std::string bake_key(const Scene& scene, const SceneBands& bands, Backend backend) {
+  if (scene.grid_source.empty()) return "";
+  std::string key = scene.grid_source + "|backend " + std::to_string(int(backend)) + "|stars";
+  for (const StarLight& s : bands.stars) key += " " + exact(s.position.x) + "," + exact(s.position.y) + "," + exact(s.position.z);
+  return key;
+}
+
+// What the diffuse field depends on besides the bakes: each band's dust and
+// table, the stars' powers and the field's settings.
+std::string diffuse_key(const std::string& bake, const Scene& scene, const SceneBands& bands, const RenderOptions& o) {
+  if (bake.empty()) return "";
+  std::string key = bake + "|mode " + to_string(scene.multiple_scattering);
+  const DiffuseSettings& d = scene.diffuse;
+  key += "|order " + std::to_string(d.order) + " cells " + std::to_string(d.cells) + " photons " +
+         std::to_string(d.photons) + " seed " + std::to_string(d.seed) + " table photons " +
+         std::to_string(o.table_photons);
+  for (size_t b = 0; b < bands.bands.size(); ++b)
+    key += "|" + bands.bands[b].name + " " + exact(bands.bands[b].extinction_ratio) + " " +
+           exact(bands.bands[b].albedo) + " " + exact(bands.bands[b].g) + " " + scene.dust.table_files[b];
+  for (const StarLight& s : bands.stars) {
+    key += "|power";
+    for (float p : s.power) key += " " + exact(p);
+  }
+  return key;
+}
+
 }  // namespace
 
 PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o) {
+  PreparedGrid none;
+  return prepare_grid(scene, o, std::move(none));
+}
+
+PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o, PreparedGrid&& previous) {
   if (scene.axial) throw Error(scene.path + ": axial: an axial scene has no 3D grid (render it with render_scene)");
   validate_scene(scene);
   check_run_memory(scene, RunKind::Fast);
@@ -62,7 +98,13 @@ PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o) {
   // Stars: one V-band depth bake each, when something scatters their light.
   std::vector<Vec3> positions;
   for (const StarLight& s : p.bands.stars) positions.push_back(s.position);
-  if (any && !positions.empty()) {
+  p.bake_key = bake_key(scene, p.bands, o.backend);
+  const bool reuse_bake = !p.bake_key.empty() && p.bake_key == previous.bake_key && !previous.bake.tau_v.empty();
+  if (any && !positions.empty() && reuse_bake) {
+    p.bake = std::move(previous.bake);
+    p.report.bake = {true, positions.size(), shape.count(), 0.0};
+    p.report.bake.reused = true;
+  } else if (any && !positions.empty()) {
     const auto t0 = std::chrono::steady_clock::now();
     std::unique_ptr<Progress> bar;
     if (o.progress && o.backend == Backend::Cpu)
@@ -75,7 +117,12 @@ PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o) {
   // Light scattered between voxels: the diffuse field, baked by photons from the stars.
   const bool diffuse = scene.multiple_scattering == MultipleScattering::Diffuse && any && !positions.empty();
   p.report.multiple_scattering = to_string(scene.multiple_scattering);
-  if (diffuse) {
+  p.diffuse_key = diffuse ? diffuse_key(p.bake_key, scene, p.bands, o) : "";
+  if (diffuse && !p.diffuse_key.empty() && p.diffuse_key == previous.diffuse_key) {
+    p.diffuse = std::move(previous.diffuse);
+    p.report.diffuse = previous.report.diffuse;
+    p.report.diffuse.reused = true;
+  } else if (diffuse) {
     const auto t0 = std::chrono::steady_clock::now();
     const std::vector<DiffuseBand> bands = diffuse_bands(p.bands, p.tables);
     const DiffuseBakeOptions options = diffuse_options(scene);
@@ -105,18 +152,21 @@ PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o) {
 RenderOutput render_prepared(const PreparedGrid& p, const CameraSettings& settings) {
   const Scene& scene = *p.scene;
   const Camera camera = make_camera(settings);
+  const int k = samples_per_pixel_side(scene.samples_per_pixel);
   RenderInputs in = p.inputs;
-  in.camera = camera;
+  // The field is a member: a moved PreparedGrid's inputs still point at the old one's.
+  if (in.diffuse) in.diffuse = &p.diffuse;
+  in.camera = make_camera(supersampled_camera(settings, scene.samples_per_pixel));
   in.exposure = 1.0f;  // science pixels: the exposure goes in the metadata
   std::unique_ptr<Progress> bar;
   if (p.options.progress && p.options.backend == Backend::Cpu)
-    bar = std::make_unique<Progress>("render", uint64_t(camera.height));
+    bar = std::make_unique<Progress>("render", uint64_t(in.camera.height));
   in.progress = bar.get();
   const PyramidResult pyramid = render_pyramid(in, p.pyramid, p.options.backend);
   if (bar) bar->finish();
 
   RenderOutput out;
-  out.image = pyramid.image;
+  out.image = box_downsample(pyramid.image, k);
   out.report = p.report;
   out.report.camera = to_string(settings.projection);
   out.report.width = camera.width;
@@ -129,6 +179,7 @@ RenderOutput render_prepared(const PreparedGrid& p, const CameraSettings& settin
   draw_scene_stars(scene, p.bands, camera, 1.0, out.image);
   out.metadata = scene_metadata(scene, p.bands, settings, p.report.mode);
   out.metadata.entries.push_back({"pyramid_levels", scene.pyramid_levels});
+  out.metadata.entries.push_back({"pixel_samples", scene.samples_per_pixel});
   out.metadata.entries.push_back({"multiple_scattering", multiple_scattering_text(out.report)});
   return out;
 }

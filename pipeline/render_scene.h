@@ -53,12 +53,21 @@ struct RenderOutput {
   RunReport report;
 };
 
-// The fast renderer on a scene: its 3D grid, with the light scattered between
+// The fast renderer on a scene: the spectral renderer when the scene has a
+// [spectral] table, else its 3D grid, with the light scattered between
 // voxels as the scene asks (render.multiple_scattering: the diffuse field, or
 // render.levels pyramid levels, or none), or its axial map. Validates the
 // scene first. Errors: Error naming the scene file and key, or ParameterError
 // for "render.levels" (more levels than the grid allows) and "smooth_step".
 RenderOutput render_scene(const Scene& scene, const RenderOptions& options);
+
+// The spectral renderer on a scene with a [spectral] table (docs/spectral.md):
+// one plane per band, each the band's filter integrated over wavelength
+// (single scattering, the thin-voxel HG phase function; no tables, no light
+// between voxels, no emission). render_scene calls it for such scenes. Errors
+// name the scene file and key; a model the spectral library refuses is
+// "<scene>: spectral: <reason>".
+RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& options);
 
 // The view-independent part of a grid render (bands, tables, star bakes, the
 // diffuse field or the pyramid's coarse levels): a new camera re-renders from
@@ -73,8 +82,17 @@ struct PreparedGrid {
   PreparedPyramid pyramid;
   RenderInputs inputs;  // everything but the camera and exposure
   RunReport report;     // the work so far
+  // What the bakes and the diffuse field were computed from (empty: never
+  // reused), compared by the re-preparing overload below.
+  std::string bake_key, diffuse_key;
 };
 PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& options);
+// The same after an edit: the star bakes (when the grid and the stars'
+// positions are unchanged) and the diffuse field (when, besides, the bands'
+// dust, tables and the stars' powers and the field's settings are) move over
+// from `previous` instead of being computed again; the report marks them
+// reused. Grids are compared by what they were made from (Scene::grid_source).
+PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& options, PreparedGrid&& previous);
 RenderOutput render_prepared(const PreparedGrid& prepared, const CameraSettings& camera);
 
 struct TruthOptions {

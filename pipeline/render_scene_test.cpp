@@ -235,6 +235,98 @@ TEST_F(RenderScene, ABandsTableFileChangesThatBandOnly) {
   EXPECT_EQ(a.report.tables[1].bands, (std::vector<std::string>{"V"}));
 }
 
+// A grey band is the V band with the star's whole luminosity: the same
+// dust (A/A_V = 1, V's albedo and g), so the image is V's scaled by L / L_V,
+// the diffuse field included (its photons carry the star's power linearly).
+TEST_F(RenderScene, TheGreyBandIsVWithTheWholeLuminosity) {
+  Scene v = scene("[render]\ndiffuse_photons = 65536\n", "albedo = 0.6\ng = 0.6\n");
+  v.bands = {"V"};
+  v.dust.albedo = {0.6};
+  v.dust.g = {0.6};
+  v.dust.table_files = {""};
+  Scene grey = v;
+  grey.bands = {"grey"};
+  const RenderOutput a = render_scene(v, options());
+  const RenderOutput b = render_scene(grey, options());
+  const double scale = scene_bands(grey).stars[0].power[0] / double(scene_bands(v).stars[0].power[0]);
+  EXPECT_GT(scale, 10.0);  // an O5V star puts little of its light in V
+  double sum_v = 0, sum_grey = 0, worst = 0;
+  for (int y = 0; y < a.image.height; ++y)
+    for (int x = 0; x < a.image.width; ++x) {
+      const double expected = scale * a.image.at(0, x, y);
+      sum_v += expected;
+      sum_grey += b.image.at(0, x, y);
+      worst = std::max(worst, std::fabs(b.image.at(0, x, y) - expected));
+    }
+  ASSERT_GT(sum_v, 0.0);
+  // Single precision throughout: the images agree to rounding.
+  EXPECT_NEAR(sum_grey / sum_v, 1.0, 1e-5);
+  EXPECT_LT(worst / (sum_v / (a.image.width * a.image.height)), 1e-3);
+}
+
+// An emitting cube whose edge x = 1 splits the middle pixel column of a
+// telescope image in two: with k x k rays over each pixel's area (k even) the
+// column is exactly half as bright as the inside; at the centre it would be
+// all or nothing.
+template <class F>
+void expect_error_naming(F f, const std::string& key) {
+  try {
+    f();
+    ADD_FAILURE() << "accepted; expected an error naming " << key;
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+  }
+}
+
+Scene edge_scene(int samples_per_pixel) {
+  Scene s;
+  s.path = "edge";
+  s.bands = {"V"};
+  s.density.shape.nx = s.density.shape.ny = s.density.shape.nz = 8;
+  s.density.shape.voxel = 0.125f;
+  s.density.tau_v.assign(512, 1e-3f);
+  s.emission = {std::vector<float>(512, 1.0f)};
+  s.dust.albedo = {0.0};
+  s.dust.g = {0.6};
+  s.dust.table_files = {""};
+  s.multiple_scattering = MultipleScattering::None;
+  s.camera.projection = Projection::Orthographic;
+  s.camera.position = {1.0f, 0.5f, -1.0f};
+  s.camera.look_at = {1.0f, 0.5f, 0.5f};
+  s.camera.up = {0, 1, 0};
+  s.camera.ortho_width = 0.9;  // 9 pixels of 0.1: column 4 spans x in [0.95, 1.05]
+  s.camera.width = 9;
+  s.camera.height = 3;
+  s.samples_per_pixel = samples_per_pixel;
+  return s;
+}
+
+TEST_F(RenderScene, SamplesPerPixelAverageThePixelsArea) {
+  for (int n : {4, 16}) {
+    const Scene s = edge_scene(n);
+    const RenderOutput fast = render_scene(s, options());
+    TruthOptions t;
+    t.spp = 2 * n;
+    const TruthRenderOutput truth = truth_scene(s, t);
+    // Which side column 2 lies on depends on the camera's handedness.
+    Vec3 o, d;
+    make_camera(s.camera).ray(2, 1, o, d);
+    const int in_x = o.x < 1.0f ? 2 : 6, out_x = 8 - in_x;
+    for (const Image* image : {&fast.image, &truth.image}) {
+      const float inside = image->at(0, in_x, 1), edge = image->at(0, 4, 1), outside = image->at(0, out_x, 1);
+      ASSERT_GT(inside, 0.0f) << n;
+      EXPECT_NEAR(edge / inside, 0.5, 1e-4) << n << (image == &fast.image ? " fast" : " truth");
+      EXPECT_EQ(outside, 0.0f) << n;
+    }
+    EXPECT_NEAR(fast.image.at(0, in_x, 1) / truth.image.at(0, in_x, 1), 1.0, 1e-3) << n;
+  }
+  // Bad input names the key, or the truth's option.
+  expect_error_naming([&] { render_scene(edge_scene(8), options()); }, "render.samples_per_pixel");
+  TruthOptions odd;
+  odd.spp = 6;
+  expect_error_naming([&] { truth_scene(edge_scene(4), odd); }, "spp");
+}
+
 TEST_F(RenderScene, ErrorsNameTheKeyOrTheField) {
   Scene s = scene();
   s.multiple_scattering = MultipleScattering::Pyramid;

@@ -16,6 +16,10 @@ RunMemory estimate_run_memory(const Scene& scene, RunKind kind) {
   m.parts.push_back({"image " + std::to_string(scene.camera.width) + " x " + std::to_string(scene.camera.height) +
                          " x " + to_text(bands) + " bands",
                      kind == RunKind::Truth ? image * 5 : image * 2});
+  // The fast renderers trace k^2 rays per pixel as an image k times finer.
+  if (kind == RunKind::Fast && scene.samples_per_pixel > 1)
+    m.parts.push_back({"the " + std::to_string(scene.samples_per_pixel) + " samples per pixel's finer image",
+                       image * scene.samples_per_pixel});
   const double cells = double(scene.diffuse.cells);
   const double coefficients = double((scene.diffuse.order + 1) * (scene.diffuse.order + 1));
   if (scene.axial) {

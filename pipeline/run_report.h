@@ -40,11 +40,13 @@ struct BakeReport {
   size_t stars = 0;
   uint64_t cells = 0;   // voxels, or texels of an axial map
   double seconds = 0;
+  bool reused = false;  // taken over from an earlier preparation (prepare_grid after an edit)
 };
 
 // The diffuse field's bake (diffuse/diffuse_bake.h).
 struct DiffuseReport {
   bool done = false;
+  bool reused = false;  // taken over from an earlier preparation (its figures are that bake's)
   int order = 0;
   GridShape cells;             // the field's cells ({along the axis, from it, 1} for an axial map)
   int voxels_per_cell = 1;     // along each axis
@@ -83,9 +85,31 @@ struct TruthReport {
   GridShape axial_grid;  // an axial map's voxelization in its own frame (nx = 0: a 3D grid scene)
 };
 
+// The spectral renderer's run (pipeline/spectral_render.cpp, docs/spectral.md).
+struct SpectralFilterReport {
+  std::string name;
+  double from_nm = 0, to_nm = 0, pivot_nm = 0;
+  int segments = 0;        // of its piecewise cubic
+  double fit_error = 0;    // largest |cubic - measured| / peak
+};
+struct SpectralReport {
+  std::string method;             // double, analytic, projection, light_density
+  int basis = 0;                  // elements used (the greedy may stop short)
+  int wavelengths = 0;            // double: samples
+  std::string attenuation, norm;  // law or inverse; relative or absolute
+  double lo_um = 0, hi_um = 0;    // the wavelength range of the basis and samples
+  double fit_depth = 0, max_depth = 0;
+  std::vector<double> elements;   // the chosen family members' optical paths a (V band)
+  double basis_error = 0;         // the greedy's largest residual over its family with all elements
+  int accumulators = 0;           // numbers each ray carries
+  std::vector<SpectralFilterReport> filters;
+  double model_seconds = 0;       // fits, basis and tables (host)
+  double resolve_seconds = 0;     // accumulators to one plane per filter
+};
+
 struct RunReport {
   std::string scene;          // the scene's path ("demo" for the built-in one)
-  std::string renderer;       // "grid", "axial" or "truth"
+  std::string renderer;       // "grid", "axial", "truth" or "spectral"
   std::string mode;           // "exact", "smooth step 0.5 voxel", "axial distance step 0.5 texel", "truth spp 16 ..."
   Backend backend = Backend::Cpu;
   std::string camera;         // the projection's name
@@ -103,6 +127,7 @@ struct RunReport {
   std::vector<PyramidLevelReport> pyramid;  // grid renders: level 0 first
   std::optional<AxialMapReport> axial;
   std::optional<TruthReport> truth;
+  std::optional<SpectralReport> spectral;
   double render_seconds = 0;  // marching or tracing only (CUDA events on the GPU)
   uint64_t table_clamps = 0;  // table lookups beyond tau_max (clamped)
   double total_seconds = 0;

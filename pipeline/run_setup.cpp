@@ -33,6 +33,10 @@ RunReport begin_report(const Scene& scene, const SceneBands& bands, const std::s
   return r;
 }
 
+std::string band_key(const std::vector<std::string>& bands, size_t b) {
+  return bands[b].size() <= kBandKeyLength ? bands[b] : "b" + std::to_string(b + 1);
+}
+
 double pivot_wavelength_nm(const Passband& p) {
   const double up = passband_integral(p, [](double l) { return l; }, kPassbandSubdivisions);
   const double down = passband_integral(p, [](double l) { return 1.0 / l; }, kPassbandSubdivisions);
@@ -108,8 +112,9 @@ ImageMetadata scene_metadata(const Scene& scene, const SceneBands& bands, const 
   meta.entries.push_back({"scene", scene.path});
   meta.entries.push_back({"mode", mode});
   for (size_t b = 0; b < scene.bands.size(); ++b) {
-    const std::string& name = scene.bands[b];
-    if (b < bands.filters.size()) meta.entries.push_back({"pivot_nm_" + name, pivot_wavelength_nm(bands.filters[b])});
+    const std::string name = band_key(scene.bands, b);
+    if (b < bands.filters.size() && !bands.filters[b].wavelength_nm.empty())
+      meta.entries.push_back({"pivot_nm_" + name, pivot_wavelength_nm(bands.filters[b])});
     meta.entries.push_back({"albedo_" + name, scene.dust.albedo[b]});
     meta.entries.push_back({"g_" + name, scene.dust.g[b]});
     meta.entries.push_back({"ext_" + name, double(bands.bands[b].extinction_ratio)});
@@ -138,7 +143,7 @@ ImageMetadata scene_metadata(const Scene& scene, const SceneBands& bands, const 
     meta.entries.push_back({s + "L_Lsun", star.luminosity_lsun});
     if (k < bands.stars.size())
       for (size_t b = 0; b < scene.bands.size() && b < bands.stars[k].power.size(); ++b)
-        meta.entries.push_back({s + "P_" + scene.bands[b], double(bands.stars[k].power[b])});
+        meta.entries.push_back({s + "P_" + band_key(scene.bands, b), double(bands.stars[k].power[b])});
   }
   meta.scene_text = scene.resolved_toml;
   return meta;
@@ -151,6 +156,29 @@ void draw_scene_stars(const Scene& scene, const SceneBands& bands, const Camera&
   for (const Band& b : bands.bands) ratios.push_back(b.extinction_ratio);
   draw_point_stars(scene.density, bands.stars, ratios, camera, static_cast<float>(exposure), scene.star_psf_pixels,
                    image);
+}
+
+CameraSettings supersampled_camera(const CameraSettings& camera, int samples_per_pixel) {
+  const int k = samples_per_pixel_side(samples_per_pixel);
+  CameraSettings fine = camera;
+  fine.width = camera.width * k;
+  fine.height = camera.height * k;
+  return fine;
+}
+
+Image box_downsample(const Image& fine, int k) {
+  if (k == 1) return fine;
+  Image out(fine.width / k, fine.height / k, fine.bands);
+  const double weight = 1.0 / (double(k) * k);
+  for (size_t b = 0; b < fine.bands.size(); ++b)
+    for (int y = 0; y < out.height; ++y)
+      for (int x = 0; x < out.width; ++x) {
+        double sum = 0;
+        for (int j = 0; j < k; ++j)
+          for (int i = 0; i < k; ++i) sum += fine.at(int(b), x * k + i, y * k + j);
+        out.at(int(b), x, y) = static_cast<float>(sum * weight);
+      }
+  return out;
 }
 
 // What the image's light between voxels came from, for its metadata.

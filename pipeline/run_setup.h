@@ -39,6 +39,13 @@ inline const char* const kRadianceVarianceUnit = "solLum2 pc-4 sr-2";
 // for the orthographic camera, angles from the view axis (TAN, ARC) for the
 // perspective and fisheye cameras (docs/image_files.md).
 MetaEntries camera_wcs(const CameraSettings& camera);
+// A band as per-band metadata keys name it (pivot_nm_<key>, albedo_<key>,
+// star1_P_<key>, ...): its name when at most kBandKeyLength characters, else
+// "b" and its plane number from 1 ("b2"): numeric keys have at most 14
+// characters (imageio/image_output.h), and "pivot_nm_" takes 9 of them.
+constexpr size_t kBandKeyLength = 5;
+std::string band_key(const std::vector<std::string>& bands, size_t b);
+
 // sqrt(integral T lambda / integral T / lambda), nm.
 double pivot_wavelength_nm(const Passband& passband);
 
@@ -64,6 +71,14 @@ DiffuseReport diffuse_report(const std::vector<DiffuseBand>& bands, const Diffus
                              double wall_seconds);
 // What an image's light between voxels (or cells) came from, for its metadata.
 std::string multiple_scattering_text(const RunReport& r);
+
+// Pixel-area sampling for the fast renderers (render.samples_per_pixel =
+// k^2): they trace the frame at k times the resolution, a k x k grid of
+// sub-pixel rays at the centres of equal strata, and each pixel is the mean
+// of its k^2 rays. supersampled_camera is that finer camera (k = 1: the same).
+CameraSettings supersampled_camera(const CameraSettings& camera, int samples_per_pixel);
+// The mean of each k x k block of `fine` (k * width x k * height).
+Image box_downsample(const Image& fine, int k);
 // A progress bar over the bake's photons on the CPU (null otherwise).
 std::unique_ptr<Progress> diffuse_progress(const std::vector<DiffuseBand>& bands, const DiffuseBakeOptions& options,
                                            const RenderOptions& o);

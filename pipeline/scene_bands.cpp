@@ -1,23 +1,39 @@
 #include "pipeline/scene_bands.h"
 
+#include <algorithm>
+
 #include "illumination/extinction.h"
 #include "illumination/filters.h"
 #include "illumination/star.h"
 
 namespace nebula {
 
+bool is_grey_band(const std::string& name) { return name == kGreyBand; }
+
 SceneBands scene_bands(const Scene& scene) {
   SceneBands out;
-  for (const std::string& name : scene.bands) out.filters.push_back(load_filter(name));
-  const std::vector<double> ratios =
-      extinction_ratios(out.filters, load_filter("V"), scene.dust.R_V, scene.dust.law);
-  for (size_t b = 0; b < scene.bands.size(); ++b)
-    out.bands.push_back(Band{scene.bands[b], static_cast<float>(ratios[b]), static_cast<float>(scene.dust.albedo[b]),
+  // The grey band has no filter: an empty passband named "grey" holds its place.
+  for (const std::string& name : scene.bands) {
+    const auto own = std::find_if(scene.filters.begin(), scene.filters.end(),
+                                  [&](const SceneFilter& f) { return f.name == name; });
+    out.filters.push_back(own != scene.filters.end() ? own->passband
+                          : is_grey_band(name)       ? Passband{kGreyBand, {}, {}}
+                                                     : load_filter(name));
+  }
+  const Passband V = load_filter("V");
+  for (size_t b = 0; b < scene.bands.size(); ++b) {
+    const double ratio = is_grey_band(scene.bands[b])
+                             ? 1.0
+                             : extinction_ratios({out.filters[b]}, V, scene.dust.R_V, scene.dust.law)[0];
+    out.bands.push_back(Band{scene.bands[b], static_cast<float>(ratio), static_cast<float>(scene.dust.albedo[b]),
                              static_cast<float>(scene.dust.g[b])});
+  }
   for (const SceneStar& star : scene.stars) {
-    const std::vector<double> fractions = band_fractions(star.temperature_K, out.filters);
     StarLight light{star.position, {}};
-    for (double f : fractions) light.power.push_back(static_cast<float>(star.luminosity_lsun * f));
+    for (const Passband& filter : out.filters) {
+      const double fraction = filter.wavelength_nm.empty() ? 1.0 : band_fraction(star.temperature_K, filter);
+      light.power.push_back(static_cast<float>(star.luminosity_lsun * fraction));
+    }
     out.stars.push_back(light);
   }
   return out;

@@ -9,8 +9,15 @@
 
 namespace nebula {
 
+// The grey band ("grey", core/bands.h): one wavelength, as radiative-transfer
+// benchmarks use. Its dust extinguishes as in V (A/A_V = 1 under every law)
+// and each star puts its whole bolometric luminosity in it.
+bool is_grey_band(const std::string& name);
+
 struct SceneBands {
-  std::vector<Passband> filters;  // per scene band, from the filter registry
+  // Per scene band, from the filter registry; the grey band's is empty (no
+  // wavelengths), so it has no pivot wavelength.
+  std::vector<Passband> filters;
   // Per scene band: its name; A_b/A_V, the scene's extinction law (and R_V)
   // averaged over the filter and normalised to the V filter's, so V is
   // exactly 1; the scene's albedo and g in that band.

@@ -148,5 +148,51 @@ TEST(SceneBands, FollowTheScenesBandsAndTheirDust) {
   EXPECT_EQ(sb.stars[0].power.size(), 2u);
 }
 
+// Grey dust ([dust] law = "grey"): every band is extinguished as V, while the
+// stars keep their filtered band powers.
+TEST(SceneBands, GreyLawExtinguishesEveryBandAsV) {
+  Scene s = scene_text("[dust]\nlaw = \"grey\"\nR_V = 3.1\n[[stars]]\nluminosity_lsun = 10\nclass = \"O5V\"\n");
+  const SceneBands grey = scene_bands(s);
+  s.dust.law = ExtinctionLaw::CCM89;
+  const SceneBands ccm = scene_bands(s);
+  ASSERT_EQ(grey.bands.size(), 3u);
+  for (size_t b = 0; b < 3; ++b) {
+    EXPECT_EQ(grey.bands[b].extinction_ratio, 1.0f) << grey.bands[b].name;
+    EXPECT_EQ(grey.stars[0].power[b], ccm.stars[0].power[b]) << grey.bands[b].name;
+  }
+  EXPECT_GT(ccm.bands[0].extinction_ratio, 1.05f);  // B, so the law mattered
+}
+
+// The grey band: no filter, the whole bolometric luminosity, A/A_V = 1 under
+// any law; beside a filtered band it changes nothing of that band.
+TEST(SceneBands, GreyBandCarriesTheWholeLuminosity) {
+  const Scene s = scene_text("[[stars]]\nluminosity_lsun = 250\ntemperature_K = 5800\n", "bands = [\"grey\", \"B\"]\n");
+  const SceneBands sb = scene_bands(s);
+  ASSERT_EQ(sb.bands.size(), 2u);
+  EXPECT_EQ(sb.bands[0].name, "grey");
+  EXPECT_EQ(sb.bands[0].extinction_ratio, 1.0f);
+  EXPECT_TRUE(sb.filters[0].wavelength_nm.empty());
+  EXPECT_EQ(sb.stars[0].power[0], 250.0f);
+  EXPECT_LT(sb.stars[0].power[1], 0.5f * 250.0f);  // B passes a fraction of a 5800 K star
+  Scene b_only = s;
+  b_only.bands = {"B"};
+  b_only.dust.albedo = {s.dust.albedo[1]};
+  b_only.dust.g = {s.dust.g[1]};
+  b_only.dust.table_files = {""};
+  const SceneBands ref = scene_bands(b_only);
+  EXPECT_EQ(sb.bands[1].extinction_ratio, ref.bands[0].extinction_ratio);
+  EXPECT_EQ(sb.stars[0].power[1], ref.stars[0].power[0]);
+}
+
+TEST(SceneBands, UnknownLawNamesTheKnownOnes) {
+  try {
+    scene_text("[dust]\nlaw = \"fitzpatrick\"\n");
+    FAIL() << "accepted an unknown law";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("dust.law"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("grey"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace nebula

@@ -74,6 +74,7 @@ TruthRenderOutput truth_scene(const Scene& scene, const TruthOptions& o) {
   }
   in.exposure = 1.0f;  // science pixels: the exposure goes in the metadata
   in.spp = o.spp;
+  in.pixel_side = samples_per_pixel_side(scene.samples_per_pixel);
   in.seed = o.seed;
   in.max_orders = o.max_orders;
   in.majorant_block = o.majorant_block;
@@ -101,6 +102,7 @@ TruthRenderOutput truth_scene(const Scene& scene, const TruthOptions& o) {
                            transmittance + " transmittance" + (o.equiangular ? " equiangular" : "") +
                            (o.max_orders ? " orders<=" + std::to_string(o.max_orders) : "") + traced;
   out.metadata = scene_metadata(scene, sb, scene.camera, mode);
+  out.metadata.entries.push_back({"pixel_samples", scene.samples_per_pixel});
   out.variance_metadata = out.metadata;
   out.variance_metadata.units = kRadianceVarianceUnit;  // of the pixel mean
   RunReport& r = out.report;

@@ -325,5 +325,53 @@ TEST(PointStars, StarBehindASlabDimsByItsOpticalDepth) {
   }
 }
 
+// Every camera kind draws a star: the image's radiance summed against each
+// pixel's own measure (corner rays' solid angle, or corner origins' area) is
+// the flux at the eye Phi / (4 pi d^2), or for the telescope the intensity
+// Phi / (4 pi), dimmed by the dust on the way.
+TEST(PointStars, EveryCameraKindConservesTheStarsLight) {
+  DensityGrid grid = testing::cube(10, 1.0f, 0.05f);
+  const Vec3 star{0.35f, 0.6f, 0.4f};
+  const StarLight light{star, {2.0f}};
+  const std::vector<float> ratios{1.0f};
+  for (Projection kind : {Projection::Perspective, Projection::Orthographic, Projection::Fisheye}) {
+    CameraSettings cs;
+    cs.projection = kind;
+    cs.position = {0.5f, 0.5f, -4.0f};
+    cs.look_at = {0.5f, 0.5f, 0.5f};
+    cs.up = {0, 1, 0};
+    cs.fov_deg = 30;
+    cs.ortho_width = 2.0;
+    cs.width = cs.height = 96;
+    const Camera camera = make_camera(cs);
+    Image image(96, 96, {"V"});
+    draw_point_stars(grid, {light}, ratios, camera, 1.0f, 1.2, image);
+    double total = 0;
+    for (int y = 0; y < 96; ++y)
+      for (int x = 0; x < 96; ++x) {
+        const float v = image.at(0, x, y);
+        if (v == 0) continue;
+        Vec3 o[4], d[4];
+        const float cx[4] = {float(x), x + 1.0f, x + 1.0f, float(x)}, cy[4] = {float(y), float(y), y + 1.0f, y + 1.0f};
+        for (int k = 0; k < 4; ++k) ASSERT_TRUE(camera.ray_through(cx[k], cy[k], o[k], d[k]));
+        double measure = 0;
+        if (kind == Projection::Orthographic) {
+          measure = length(cross(o[1] - o[0], o[3] - o[0]));
+        } else {  // two small spherical triangles, by their planar areas on the unit sphere
+          measure = 0.5 * (length(cross(d[1] - d[0], d[2] - d[0])) + length(cross(d[2] - d[0], d[3] - d[0])));
+        }
+        total += v * measure;
+      }
+    // The path through the dust from the eye (or the image plane) to the star.
+    const Vec3 eye = kind == Projection::Orthographic ? Vec3{star.x, star.y, -4.0f} : cs.position;
+    const double tau = segment_optical_depth(grid.view(), eye, star);
+    EXPECT_GT(tau, 0.1);
+    const double r2 = double(dot(star - cs.position, star - cs.position));
+    const double expected =
+        2.0 / (4 * kPiD) * std::exp(-tau) / (kind == Projection::Orthographic ? 1.0 : r2);
+    EXPECT_NEAR(total / expected, 1.0, 0.01) << to_string(kind);
+  }
+}
+
 }  // namespace
 }  // namespace nebula

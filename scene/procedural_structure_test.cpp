@@ -80,13 +80,13 @@ TEST(ReuseGrids, TakesTheDensityOverOnlyWhenItsTablesAreUnchanged) {
       "[camera]\nposition = [1, -3, 1]\nlook_at = [1, 1, 1]\n";
   Scene previous = load_scene_text(text, "s.toml", ".");
   previous.density.tau_v[0] = 123.0f;  // a mark: seen again only if the grid is taken over
-  const Scene edited = load_scene_text_reusing_grids(text, "s.toml", ".", {"dust.albedo=0.9", "stars.0.luminosity_lsun=5e3"}, previous);
+  const Scene edited = load_scene_text(text, "s.toml", ".", {"dust.albedo=0.9", "stars.0.luminosity_lsun=5e3"}, &previous);
   EXPECT_EQ(edited.density.tau_v[0], 123.0f);
   EXPECT_EQ(edited.dust.albedo[0], 0.9);
   EXPECT_EQ(edited.stars[0].luminosity_lsun, 5e3);
-  const Scene reseeded = load_scene_text_reusing_grids(text, "s.toml", ".", {"density.procedural.seed=2"}, previous);
+  const Scene reseeded = load_scene_text(text, "s.toml", ".", {"density.procedural.seed=2"}, &previous);
   EXPECT_NE(reseeded.density.tau_v[0], 123.0f);
-  const Scene scaled = load_scene_text_reusing_grids(text, "s.toml", ".", {"density.scale=2"}, previous);
+  const Scene scaled = load_scene_text(text, "s.toml", ".", {"density.scale=2"}, &previous);
   EXPECT_NE(scaled.density.tau_v[0], 123.0f);
 }
 

@@ -1,10 +1,13 @@
 #include "scene/scene.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <set>
 
+#include "core/bands.h"
 #include "core/error.h"
+#include "illumination/extinction.h"
 #include "illumination/filters.h"
 #include "illumination/star.h"
 #include "scene/density_sources.h"
@@ -91,18 +94,111 @@ std::optional<SceneIssue> star_issue(const SceneStar& star, const std::string& k
 
 }  // namespace
 
-std::optional<SceneIssue> band_issue(const std::string& band) {
-  if (is_renderable_filter(band)) return std::nullopt;
+std::optional<SceneIssue> band_issue(const std::string& band, const std::vector<SceneFilter>& filters) {
+  if (is_renderable_filter(band) || band == kGreyBand) return std::nullopt;
+  for (const SceneFilter& f : filters)
+    if (f.name == band) return std::nullopt;
   std::string known;
   for (const std::string& name : renderable_filters()) known += (known.empty() ? "" : ", ") + name;
-  return SceneIssue{"bands", "'" + band + "' is not a known band (known: " + known + ")"};
+  return SceneIssue{"bands", "'" + band + "' is not a known band (known: " + known + ", " + kGreyBand +
+                                 (filters.empty() ? "" : "; or a filter of the scene's [filters] table") + ")"};
+}
+
+std::optional<SceneIssue> filter_issue(const SceneFilter& f) {
+  const std::string key = "filters." + f.name;
+  const bool letter = !f.name.empty() && std::isalpha(static_cast<unsigned char>(f.name[0]));
+  bool chars = f.name.size() <= 24;
+  for (char c : f.name) chars = chars && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-');
+  if (!letter || !chars)
+    return SceneIssue{key, "a filter name is 1 to 24 characters of [A-Za-z0-9_-] starting with a letter"};
+  if (f.name.size() >= 2 && f.name[0] == 'b' && f.name.find_first_not_of("0123456789", 1) == std::string::npos)
+    return SceneIssue{key, "'" + f.name + "': b<number> names a plane in image metadata; give the filter another name"};
+  if (is_renderable_filter(f.name))
+    return SceneIssue{key, "'" + f.name + "' is a built-in filter (`nebula filters`); give the file another name"};
+  const Passband& p = f.passband;
+  if (p.wavelength_nm.size() < 2 || p.wavelength_nm.size() != p.response.size())
+    return SceneIssue{key, "the curve '" + f.path + "' has fewer than 2 rows"};
+  const double lo = 1000.0 / kExtinctionMaxInverseMicron, hi = 1000.0 / kExtinctionMinInverseMicron;
+  if (!(p.wavelength_nm.front() >= lo && p.wavelength_nm.back() <= hi))
+    return SceneIssue{key, "the curve '" + f.path + "' spans " + to_text(p.wavelength_nm.front()) + " to " +
+                               to_text(p.wavelength_nm.back()) + " nm, outside the extinction law's " + to_text(lo) +
+                               " to " + to_text(hi) + " nm"};
+  return std::nullopt;
+}
+
+std::optional<SceneIssue> spectral_issue(const Scene& s) {
+  const SpectralSpec& p = *s.spectral;
+  const bool known_method = p.method == "double" || p.method == "analytic" || p.method == "projection" ||
+                            p.method == "light_density";
+  if (!known_method)
+    return SceneIssue{"spectral.method",
+                      "'" + p.method + "' is not a method (known: double, analytic, projection, light_density)"};
+  if (p.basis < 1 || p.basis > 16)
+    return SceneIssue{"spectral.basis", "is " + std::to_string(p.basis) + "; must be in 1..16 (basis elements)"};
+  if (p.wavelengths < 2 || p.wavelengths > 4096)
+    return SceneIssue{"spectral.wavelengths", "is " + std::to_string(p.wavelengths) + "; must be in 2..4096"};
+  if (p.attenuation != "law" && p.attenuation != "inverse")
+    return SceneIssue{"spectral.attenuation", "'" + p.attenuation + "' is not an attenuation (known: law, inverse)"};
+  if (p.method == "analytic" && p.attenuation != "inverse")
+    return SceneIssue{"spectral.method", "analytic integrates polynomials times e^(-a/lambda): it needs "
+                                         "spectral.attenuation = \"inverse\""};
+  if (p.norm != "relative" && p.norm != "absolute")
+    return SceneIssue{"spectral.norm", "'" + p.norm + "' is not a norm (known: relative, absolute)"};
+  for (const auto& [key, v] : {std::pair{"spectral.fit_depth", p.fit_depth}, std::pair{"spectral.max_depth", p.max_depth}})
+    if (!(std::isfinite(v) && v >= 0 && v <= 1000))
+      return SceneIssue{key, "is " + to_text(v) + "; must be in [0, 1000] (V-band optical depth; 0: automatic)"};
+  if (p.fit_depth > 0 && p.max_depth > 0 && p.fit_depth > p.max_depth)
+    return SceneIssue{"spectral.fit_depth", "is " + to_text(p.fit_depth) + ", beyond spectral.max_depth " +
+                                                to_text(p.max_depth)};
+  if (p.range_lo_um != 0 || p.range_hi_um != 0)
+    if (!(std::isfinite(p.range_lo_um) && std::isfinite(p.range_hi_um) && p.range_lo_um > 0 &&
+          p.range_hi_um > p.range_lo_um))
+      return SceneIssue{"spectral.range_um", "must be [lo, hi] in um with 0 < lo < hi"};
+  if (s.axial) return SceneIssue{"spectral", "the spectral renderer draws 3D grids; this scene is an axial map"};
+  for (const std::string& band : s.bands)
+    if (band == kGreyBand)
+      return SceneIssue{"bands", "the grey band has no wavelengths; the spectral renderer integrates over filters"};
+  if (!s.emission.empty())
+    return SceneIssue{"spectral", "the spectral renderer has no emission yet; leave out [emission]"};
+  if (!all_equal(s.dust.albedo))
+    return SceneIssue{"dust.albedo", "the spectral renderer takes one albedo for every wavelength; give one number"};
+  if (!all_equal(s.dust.g))
+    return SceneIssue{"dust.g", "the spectral renderer takes one g for every wavelength; give one number"};
+  for (const std::string& f : s.dust.table_files)
+    if (!f.empty()) return SceneIssue{"dust.tables", "the spectral renderer uses no scattering tables"};
+  if (p.method == "projection" && s.stars.size() * size_t(p.basis) > 64)
+    return SceneIssue{"spectral.basis", std::to_string(s.stars.size()) + " stars x " + std::to_string(p.basis) +
+                                            " elements exceed the 64 numbers a ray carries; use method = "
+                                            "\"light_density\" (any number of stars)"};
+  // The light-density basis is tabulated over star temperature (spectral/spectral_model.cpp).
+  if (p.method == "light_density")
+    for (size_t i = 0; i < s.stars.size(); ++i)
+      if (!(s.stars[i].temperature_K >= 2000 && s.stars[i].temperature_K <= 60000))
+        return SceneIssue{"stars." + std::to_string(i) + ".temperature_K",
+                          "is " + to_text(s.stars[i].temperature_K) +
+                              " K, outside the light-density basis' 2000 to 60000 K"};
+  return std::nullopt;
+}
+
+std::optional<SceneIssue> samples_per_pixel_issue(int n) {
+  const int side = samples_per_pixel_side(n);
+  if (n < 1 || n > kMaxSamplesPerPixel || side * side != n)
+    return SceneIssue{"render.samples_per_pixel", "is " + std::to_string(n) +
+                                                      "; must be a square in 1..256 (1, 4, 9, 16, ...: k x k "
+                                                      "stratified rays per pixel)"};
+  return std::nullopt;
 }
 
 std::optional<SceneIssue> settings_issue(const Scene& s) {
   if (s.bands.empty()) return SceneIssue{"bands", "must name at least one band"};
   std::set<std::string> seen;
+  std::set<std::string> filter_names;
+  for (const SceneFilter& f : s.filters) {
+    if (auto issue = filter_issue(f)) return issue;
+    if (!filter_names.insert(f.name).second) return SceneIssue{"filters." + f.name, "appears twice"};
+  }
   for (const std::string& band : s.bands) {
-    if (auto issue = band_issue(band)) return issue;
+    if (auto issue = band_issue(band, s.filters)) return issue;
     if (!seen.insert(band).second) return SceneIssue{"bands", "'" + band + "' appears twice"};
   }
   if (auto issue = per_band_issue(s, s.dust.albedo, "albedo", "in [0, 1]",
@@ -139,6 +235,8 @@ std::optional<SceneIssue> settings_issue(const Scene& s) {
   if (s.diffuse.photons < 1 || s.diffuse.photons > 0xFFFFFFFFull)
     return SceneIssue{"render.diffuse_photons",
                       "is " + std::to_string(s.diffuse.photons) + "; must be in 1..4294967295 (per band)"};
+  if (auto issue = samples_per_pixel_issue(s.samples_per_pixel)) return issue;
+  if (s.spectral) return spectral_issue(s);
   return std::nullopt;
 }
 

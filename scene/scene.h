@@ -18,6 +18,7 @@
 #include "core/vec3.h"
 #include "illumination/extinction.h"
 #include "scene/camera_path.h"
+#include "illumination/passband.h"
 
 namespace nebula {
 
@@ -88,6 +89,30 @@ struct DiffuseSettings {
   uint64_t seed = 1;
 };
 
+// A filter read from a file the scene names ([filters] in a scene file): a
+// band like the built-in filters (illumination/filters.h).
+struct SceneFilter {
+  std::string name;   // as `bands` names it
+  std::string path;   // resolved against the scene's folder
+  Passband passband;  // illumination/filter_file.h
+};
+
+// The spectral renderer ([spectral] in a scene file; docs/scene.md,
+// docs/spectral.md): every band integrated over wavelength through its filter
+// (Barres 2023) instead of the band renderer's one extinction ratio and star
+// power per band. Single scattering in each voxel (the thin-voxel HG phase
+// function), no tables, no light between voxels.
+struct SpectralSpec {
+  std::string method = "projection";  // double, analytic, projection, light_density
+  int basis = 4;                      // elements of the greedy basis, 1..16
+  int wavelengths = 20;               // double: wavelength samples, 2..4096
+  std::string attenuation = "law";    // law (dust.law, dust.R_V) or inverse (C_T / lambda, the report's)
+  std::string norm = "relative";      // relative (ours) or absolute (the report's)
+  double fit_depth = 0;               // V-band optical paths the basis is fitted on; 0: automatic (8)
+  double max_depth = 0;               // the coefficient table's range; 0: automatic
+  double range_lo_um = 0, range_hi_um = 0;  // the basis' wavelength range; 0: the bands' span
+};
+
 // A file a scene reads: the key that names it ("scene" for the scene file
 // itself) and the path as resolved. Front ends refuse to write over any of them.
 struct SceneInput {
@@ -100,7 +125,12 @@ struct Scene {
   // for a scene built in code): what images record as their scene.
   std::string resolved_toml;
   std::vector<SceneInput> inputs;  // every file the scene reads (load_scene fills it)
+  // What the density and emission grids were made from, as text (load_scene
+  // fills it; empty for a scene built in code): equal texts, equal grids.
+  std::string grid_source;
   std::vector<std::string> bands{"B", "V", "R"};
+  std::vector<SceneFilter> filters;        // user filters the bands may name
+  std::optional<SpectralSpec> spectral;    // set: render with the spectral renderer
   DensityGrid density;  // tau_v per voxel (empty for an axial scene)
   std::optional<AxialSpec> axial;  // set instead of a density grid
   // Empty, or one grid per band (bands order) with the density's shape: the
@@ -123,7 +153,19 @@ struct Scene {
   // for multiple_scattering = Pyramid; at most the grid allows
   // (multires/volume_pyramid.h), checked by the renderer.
   int pyramid_levels = 0;
+  // Rays per pixel ([render] samples_per_pixel): k x k stratified over the
+  // pixel's area, so a pixel is its area's mean, not its centre's value (the
+  // 1/d cusp next to a star). A square in 1..kMaxSamplesPerPixel.
+  int samples_per_pixel = 1;
 };
+
+constexpr int kMaxSamplesPerPixel = 256;
+// k for samples_per_pixel = k^2 (the rounded square root; check the square).
+inline int samples_per_pixel_side(int n) {
+  int k = 1;
+  while ((k + 1) * (k + 1) <= n) ++k;
+  return k;
+}
 
 // Checks a Scene built in code (load_scene checks the same rules and more):
 // bands, per-band vector sizes, albedo, g, R_V, stars, camera, output, grid

@@ -26,8 +26,10 @@ std::optional<SceneIssue> settings_issue(const Scene& scene);
 // The density and emission grids: shapes, sizes and values.
 std::optional<SceneIssue> grids_issue(const Scene& scene);
 
-// A band a scene may render (illumination/filters.h), or its issue.
-std::optional<SceneIssue> band_issue(const std::string& band);
+// A band a scene may render (illumination/filters.h, or one of the scene's
+// own [filters]), or its issue.
+std::optional<SceneIssue> band_issue(const std::string& band, const std::vector<SceneFilter>& filters = {});
+std::optional<SceneIssue> samples_per_pixel_issue(int n);
 
 inline std::string number_text(double v) { return to_text(v); }
 

@@ -18,6 +18,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "illumination/filter_file.h"
 #include "illumination/star.h"
 #include "scene/camera_path_toml.h"
 #include "scene/display_toml.h"
@@ -60,11 +61,14 @@ const char* type_name(const toml::node& n) {
 }
 
 // The keys of every table in a scene file.
-const std::initializer_list<std::string_view> kTopKeys = {"bands",  "density", "emission", "dust",
-                                                          "stars",  "camera",  "output", "render", "axial",
-                                                          "animation", "display"};
+const std::initializer_list<std::string_view> kTopKeys = {"bands",  "density", "emission", "dust",   "stars",
+                                                          "camera", "output",  "render",   "axial",  "filters",
+                                                          "spectral", "animation", "display"};
+const std::initializer_list<std::string_view> kSpectralKeys = {
+    "method", "basis", "wavelengths", "attenuation", "norm", "fit_depth", "max_depth", "range_um"};
 const std::initializer_list<std::string_view> kRenderKeys = {
-    "levels", "multiple_scattering", "diffuse_order", "diffuse_cells", "diffuse_photons", "diffuse_seed"};
+    "levels", "multiple_scattering", "diffuse_order", "diffuse_cells", "diffuse_photons", "diffuse_seed",
+    "samples_per_pixel"};
 const std::initializer_list<std::string_view> kAxialKeys = {
     "synthetic", "file", "image", "dataset", "emission_prefix", "tau_channel", "emission_channels", "nx", "nr",
     "length_pc", "tau_scale", "emission_scale", "origin", "axis", "skip", "step_texels"};
@@ -147,10 +151,7 @@ class Parser {
   }
 
   void apply_override(toml::table& root, const std::string& text);
-  Scene build(toml::table& root);
-  // A scene whose grids this one takes over when its [density], [emission]
-  // and bands are the same (load_scene_text_reusing_grids).
-  const Scene* reuse_grids = nullptr;
+  Scene build(toml::table& root, const Scene* reuse_grids = nullptr);
 
  private:
   // ------------------------------------------------ typed access
@@ -256,7 +257,9 @@ class Parser {
 
   // ------------------------------------------------ sections
 
-  std::vector<std::string> parse_bands(const toml::table& root) const;
+  std::vector<std::string> parse_bands(const toml::table& root, const std::vector<SceneFilter>& filters) const;
+  std::vector<SceneFilter> parse_filters(const toml::table& root) const;
+  std::optional<SpectralSpec> parse_spectral(const toml::table& root) const;
   DensityPlan parse_density(const toml::table& root) const;
   AxialSpec parse_axial(const toml::table& root, const std::vector<std::string>& bands) const;
   ProceduralParams parse_procedural(const toml::table& t, const std::string& key) const;
@@ -268,23 +271,6 @@ class Parser {
   void parse_render(const toml::table& root, Scene& scene) const;
   void load_grids(const DensityPlan& density, const std::optional<EmissionPlan>& emission,
                   Scene& scene) const;
-  bool reused_grids(const toml::table& root, Scene& scene) const {
-    if (reuse_grids == nullptr || reuse_grids->resolved_toml.empty() || reuse_grids->axial) return false;
-    toml::table previous;
-    try {
-      previous = toml::parse(std::string_view(reuse_grids->resolved_toml));
-    } catch (const toml::parse_error&) {
-      return false;
-    }
-    for (const char* key : {"density", "emission", "bands"}) {
-      const toml::node *a = root.get(key), *b = previous.get(key);
-      if ((a == nullptr) != (b == nullptr)) return false;
-      if (a != nullptr && !(toml::node_view<const toml::node>(a) == toml::node_view<const toml::node>(b))) return false;
-    }
-    scene.density = reuse_grids->density;
-    scene.emission = reuse_grids->emission;
-    return true;
-  }
 
   std::string name_;
   fs::path base_;
@@ -372,7 +358,50 @@ void Parser::apply_override(toml::table& root, const std::string& text) {
 
 // ------------------------------------------------------------ sections
 
-std::vector<std::string> Parser::parse_bands(const toml::table& root) const {
+std::vector<SceneFilter> Parser::parse_filters(const toml::table& root) const {
+  std::vector<SceneFilter> filters;
+  const toml::node* n = root.get("filters");
+  if (n == nullptr) return filters;
+  const toml::table& t = table_at(*n, "filters");
+  for (auto&& [k, v] : t) {
+    SceneFilter f;
+    f.name = std::string(k.str());
+    const std::string key = "filters." + f.name;
+    f.path = data_path(v, key);
+    try {
+      f.passband = load_filter_file(f.path);
+    } catch (const Error& e) {
+      fail(key, e.what());
+    }
+    filters.push_back(std::move(f));
+  }
+  return filters;
+}
+
+std::optional<SpectralSpec> Parser::parse_spectral(const toml::table& root) const {
+  const toml::node* n = root.get("spectral");
+  if (n == nullptr) return std::nullopt;
+  const toml::table& t = table_at(*n, "spectral");
+  known_keys(t, "spectral", kSpectralKeys);
+  SpectralSpec p;
+  if (const toml::node* v = t.get("method")) p.method = lower(string(*v, "spectral.method"));
+  if (const toml::node* v = t.get("basis")) p.basis = small_integer(*v, "spectral.basis");
+  if (const toml::node* v = t.get("wavelengths")) p.wavelengths = small_integer(*v, "spectral.wavelengths");
+  if (const toml::node* v = t.get("attenuation")) p.attenuation = lower(string(*v, "spectral.attenuation"));
+  if (const toml::node* v = t.get("norm")) p.norm = lower(string(*v, "spectral.norm"));
+  if (const toml::node* v = t.get("fit_depth")) p.fit_depth = number(*v, "spectral.fit_depth");
+  if (const toml::node* v = t.get("max_depth")) p.max_depth = number(*v, "spectral.max_depth");
+  if (const toml::node* v = t.get("range_um")) {
+    const toml::array* a = v->as_array();
+    if (a == nullptr || a->size() != 2)
+      fail("spectral.range_um", "must be an array of 2 numbers [lo, hi] in um");
+    p.range_lo_um = number((*a)[0], "spectral.range_um[0]");
+    p.range_hi_um = number((*a)[1], "spectral.range_um[1]");
+  }
+  return p;
+}
+
+std::vector<std::string> Parser::parse_bands(const toml::table& root, const std::vector<SceneFilter>& filters) const {
   const toml::node* n = root.get("bands");
   if (n == nullptr) return {"B", "V", "R"};
   const toml::array* a = n->as_array();
@@ -381,7 +410,7 @@ std::vector<std::string> Parser::parse_bands(const toml::table& root) const {
   for (size_t i = 0; i < a->size(); ++i) bands.push_back(string((*a)[i], "bands[" + std::to_string(i) + "]"));
   if (bands.empty()) fail("bands", "must name at least one band");
   for (size_t i = 0; i < bands.size(); ++i) {
-    if (auto issue = scene_detail::band_issue(bands[i])) fail(issue->key, issue->reason);
+    if (auto issue = scene_detail::band_issue(bands[i], filters)) fail(issue->key, issue->reason);
     for (size_t j = 0; j < i; ++j)
       if (bands[j] == bands[i]) fail("bands", "'" + bands[i] + "' appears twice");
   }
@@ -597,8 +626,10 @@ DustParams Parser::parse_dust(const toml::table& root, const std::vector<std::st
       dust.law = ExtinctionLaw::CCM89;
     else if (lower(law) == "odonnell94")
       dust.law = ExtinctionLaw::ODonnell94;
+    else if (lower(law) == "grey" || lower(law) == "gray")
+      dust.law = ExtinctionLaw::Grey;
     else
-      fail("dust.law", "'" + law + "' is not a known law (known: ccm89, odonnell94)");
+      fail("dust.law", "'" + law + "' is not a known law (known: ccm89, odonnell94, grey)");
   }
   if (const toml::node* tb = t.get("tables")) {
     const toml::table& tables = table_at(*tb, "dust.tables");
@@ -731,6 +762,10 @@ void Parser::parse_render(const toml::table& root, Scene& scene) const {
   };
   count("diffuse_photons", d.photons);
   count("diffuse_seed", d.seed);
+  if (const toml::node* v = t.get("samples_per_pixel")) {
+    scene.samples_per_pixel = small_integer(*v, "render.samples_per_pixel");
+    if (auto issue = scene_detail::samples_per_pixel_issue(scene.samples_per_pixel)) fail(issue->key, issue->reason);
+  }
 }
 
 void Parser::load_grids(const DensityPlan& density, const std::optional<EmissionPlan>& emission,
@@ -767,11 +802,13 @@ void Parser::load_grids(const DensityPlan& density, const std::optional<Emission
   }
 }
 
-Scene Parser::build(toml::table& root) {
+Scene Parser::build(toml::table& root, const Scene* reuse_grids) {
   known_keys(root, "", kTopKeys);
   Scene scene;
   scene.path = name_;
-  scene.bands = parse_bands(root);
+  scene.filters = parse_filters(root);
+  scene.bands = parse_bands(root, scene.filters);
+  scene.spectral = parse_spectral(root);
   const bool axial = root.get("axial") != nullptr;
   if (axial && root.get("density") != nullptr)
     fail_tables("axial", "conflicts with [density]: a scene is either a 3D grid or an axial map", {"axial", "density"});
@@ -815,16 +852,32 @@ Scene Parser::build(toml::table& root) {
   if (!density.path.empty()) scene.inputs.push_back({density.key, density.path});
   if (emission) scene.inputs.push_back({"emission.file", emission->path});
   if (axial && !scene.axial->path.empty()) scene.inputs.push_back({"axial." + scene.axial->source, scene.axial->path});
+  for (const SceneFilter& f : scene.filters) scene.inputs.push_back({"filters." + f.name, f.path});
   for (size_t b = 0; b < scene.dust.table_files.size(); ++b)
     if (!scene.dust.table_files[b].empty())
       scene.inputs.push_back({"dust.tables." + scene.bands[b], scene.dust.table_files[b]});
-  if (!axial && !reused_grids(root, scene)) load_grids(density, emission, scene);  // the expensive part, last
+  // What the grids are made of: the [density] and [emission] tables as
+  // printed, the bands (emission grids follow them) and the scene's folder.
+  if (!axial) {
+    std::ostringstream source;
+    source << "base=" << base_.string() << "\nbands=";
+    for (const std::string& b : scene.bands) source << b << ",";
+    if (const toml::table* d = root["density"].as_table()) source << "\n[density]\n" << toml::toml_formatter(*d);
+    if (const toml::table* e = root["emission"].as_table()) source << "\n[emission]\n" << toml::toml_formatter(*e);
+    scene.grid_source = source.str();
+  }
+  if (!axial && reuse_grids && !reuse_grids->grid_source.empty() && reuse_grids->grid_source == scene.grid_source) {
+    scene.density = reuse_grids->density;
+    scene.emission = reuse_grids->emission;
+  } else if (!axial) {
+    load_grids(density, emission, scene);  // the expensive part, last
+  }
   if (const auto issue = scene_detail::grids_issue(scene)) fail(issue->key, issue->reason);
   return scene;
 }
 
 Scene parse_scene(const std::string& text, const std::string& name, const fs::path& base,
-                  const std::vector<std::string>& overrides, const Scene* reuse = nullptr) {
+                  const std::vector<std::string>& overrides, const Scene* reuse_grids) {
   toml::table root;
   try {
     root = toml::parse(std::string_view(text), std::string_view(name));
@@ -835,12 +888,11 @@ Scene parse_scene(const std::string& text, const std::string& name, const fs::pa
                          std::string(e.description())));
   }
   Parser parser(name, base);
-  parser.reuse_grids = reuse;
   parser.note_file_tables(root);
   for (const std::string& o : overrides) parser.apply_override(root, o);
   std::ostringstream resolved;
   resolved << toml::toml_formatter(root);
-  Scene scene = parser.build(root);
+  Scene scene = parser.build(root, reuse_grids);
   scene.resolved_toml = resolved.str();
   return scene;
 }
@@ -848,13 +900,8 @@ Scene parse_scene(const std::string& text, const std::string& name, const fs::pa
 }  // namespace
 
 Scene load_scene_text(const std::string& text, const std::string& name, const std::string& base_dir,
-                      const std::vector<std::string>& overrides) {
-  return parse_scene(text, name, fs::path(base_dir), overrides);
-}
-
-Scene load_scene_text_reusing_grids(const std::string& text, const std::string& name, const std::string& base_dir,
-                                    const std::vector<std::string>& overrides, const Scene& previous) {
-  return parse_scene(text, name, fs::path(base_dir), overrides, &previous);
+                      const std::vector<std::string>& overrides, const Scene* reuse_grids) {
+  return parse_scene(text, name, fs::path(base_dir), overrides, reuse_grids);
 }
 
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
@@ -868,7 +915,7 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw Error(path + ": cannot read the scene file");
-  Scene scene = parse_scene(text.str(), path, fs::path(path).parent_path(), overrides);
+  Scene scene = parse_scene(text.str(), path, fs::path(path).parent_path(), overrides, nullptr);
   scene.inputs.insert(scene.inputs.begin(), SceneInput{"scene", path});
   return scene;
 }

@@ -21,22 +21,21 @@ namespace nebula {
 Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
 
 // The same, from TOML text; `name` stands for the file in messages and
-// `base_dir` resolves relative data paths.
+// `base_dir` resolves relative data paths. With `reuse_grids`, a scene whose
+// grids come from the same [density] and [emission] tables, bands and folder
+// (Scene::grid_source) copies that scene's grids instead of reading or
+// generating them again (edits and sweeps; files changed on disk meanwhile
+// are not seen).
 Scene load_scene_text(const std::string& text, const std::string& name,
-                      const std::string& base_dir, const std::vector<std::string>& overrides = {});
+                      const std::string& base_dir, const std::vector<std::string>& overrides = {},
+                      const Scene* reuse_grids = nullptr);
 
-// load_scene_text, taking over `previous`'s density and emission grids
-// instead of reading or generating them again when its resolved [density],
-// [emission] and bands equal this one's (and it was read from the same text
-// and folder: the caller's part). The viewer's re-bake after an edit of the
-// dust, a star or the camera.
-Scene load_scene_text_reusing_grids(const std::string& text, const std::string& name, const std::string& base_dir,
-                                    const std::vector<std::string>& overrides, const Scene& previous);
-
-// The built-in demo (`nebula render --demo`), equal to scenes/demo.toml: the
-// default procedural nebula (128^3 voxels, 2 pc), one O5V star of 2e5 L_sun
-// at the procedural star, a 512 x 512 perspective camera 3.5 pc away on the
-// near side (-y) looking at the star, dust a = g = 0.6, R_V = 5 (CCM89).
+// The built-in demo (`nebula render --demo`), equal to scenes/demo.toml: a
+// procedural nebula tuned to show structure (128^3 voxels, 2 pc; the star
+// off-centre, filaments, docs/scene.md), one O5V star of 2e5 L_sun at the
+// procedural star, a 512 x 512 perspective camera on the near side (-y)
+// looking past the star, dust a = g = 0.6, R_V = 5 (CCM89), an asinh display
+// with auto exposure, and a camera path for `nebula animate --demo`.
 ProceduralParams demo_procedural_params();
 Scene demo_scene();
 

@@ -331,7 +331,7 @@ TEST_F(SceneFile, RefusesBadDust) {
   refused("rv_low", edited("R_V = 5.0", "R_V = 1.5"), {"dust.R_V", "[2, 6]"});
   refused("rv_high", edited("R_V = 5.0", "R_V = 6.5"), {"dust.R_V", "[2, 6]"});
   refused("law", edited("R_V = 5.0", "law = \"fitzpatrick99\""), {"dust.law", "fitzpatrick99"});
-  refused("bands", std::string("bands = [\"B\", \"U\"]\n") + kBase, {"bands", "'U'"});
+  refused("bands", std::string("bands = [\"B\", \"X\"]\n") + kBase, {"bands", "'X'"});
   refused("bands_twice", std::string("bands = [\"B\", \"B\"]\n") + kBase, {"bands", "twice"});
 }
 
@@ -563,6 +563,60 @@ TEST_F(SceneFile, RenderLevelsIsReadAndChecked) {
   refused("negative", std::string(kBase) + "[render]\nlevels = -1\n", {"render.levels", "0..16"});
   refused("float", std::string(kBase) + "[render]\nlevels = 1.5\n", {"render.levels", "integer"});
   refused("unknown", std::string(kBase) + "[render]\nstep = 1\n", {"render.step"});
+}
+
+// [filters]: a user curve a band may name; [spectral]: the spectral renderer's
+// settings, each bad value refused naming its key.
+TEST_F(SceneFile, UserFiltersAndTheSpectralTableAreReadAndChecked) {
+  write_text("filters/ha.txt", "# H-alpha, 3 nm\n650 0\n655, 0.9\n656.3\t1.0\n660 0\n");
+  const std::string with_filter =
+      std::string("bands = [\"V\", \"Halpha\", \"sdss_g\"]\n[filters]\nHalpha = \"filters/ha.txt\"\n") + kBase;
+  const Scene plain = load_scene(write_text("filter.toml", with_filter));
+  ASSERT_EQ(plain.filters.size(), 1u);
+  EXPECT_EQ(plain.filters[0].name, "Halpha");
+  EXPECT_EQ(plain.filters[0].passband.wavelength_nm.size(), 4u);
+  EXPECT_EQ(plain.bands[1], "Halpha");
+  EXPECT_FALSE(plain.spectral);
+  bool listed = false;
+  for (const SceneInput& in : plain.inputs) listed = listed || in.key == "filters.Halpha";
+  EXPECT_TRUE(listed);
+
+  const Scene spectral = load_scene(write_text("spectral.toml", with_filter + "[spectral]\nmethod = \"Double\"\n"
+                                                                              "wavelengths = 64\nfit_depth = 6\n"));
+  ASSERT_TRUE(spectral.spectral);
+  EXPECT_EQ(spectral.spectral->method, "double");
+  EXPECT_EQ(spectral.spectral->wavelengths, 64);
+  EXPECT_EQ(spectral.spectral->basis, 4);
+  EXPECT_EQ(spectral.spectral->fit_depth, 6.0);
+  EXPECT_EQ(spectral.spectral->attenuation, "law");
+
+  write_text("filters/bad.txt", "650 0\n660 1\n655 1\n");
+  refused("bad_curve", std::string("bands = [\"Hx\"]\n[filters]\nHx = \"filters/bad.txt\"\n") + kBase,
+          {"filters.Hx", "bad.txt:3", "strictly ascending"});
+  refused("missing_curve", std::string("[filters]\nHy = \"filters/none.txt\"\n") + kBase, {"filters.Hy", "cannot open"});
+  write_text("filters/v.txt", "500 0\n550 1\n600 0\n");
+  refused("builtin_name", std::string("[filters]\nV = \"filters/v.txt\"\n") + kBase, {"filters.V", "built-in"});
+  refused("plane_name", std::string("[filters]\nb2 = \"filters/v.txt\"\n") + kBase, {"filters.b2", "plane"});
+  refused("unknown_band", std::string("bands = [\"Hz\"]\n") + kBase, {"bands", "'Hz'"});
+  const std::string s = std::string(kBase) + "[spectral]\n";
+  refused("basis_zero", s + "basis = 0\n", {"spectral.basis", "1..16"});
+  refused("basis_big", s + "basis = 17\n", {"spectral.basis", "1..16"});
+  refused("method", s + "method = \"fast\"\n", {"spectral.method", "'fast'"});
+  refused("analytic_law", s + "method = \"analytic\"\n", {"spectral.method", "inverse"});
+  refused("samples", s + "method = \"double\"\nwavelengths = 1\n", {"spectral.wavelengths", "2..4096"});
+  refused("attenuation", s + "attenuation = \"fitz\"\n", {"spectral.attenuation", "'fitz'"});
+  refused("norm", s + "norm = \"max\"\n", {"spectral.norm", "'max'"});
+  refused("fit_depth", s + "fit_depth = -1\n", {"spectral.fit_depth", "[0, 1000]"});
+  refused("fit_past_max", s + "fit_depth = 9\nmax_depth = 5\n", {"spectral.fit_depth", "max_depth"});
+  refused("range", s + "range_um = [0.9, 0.3]\n", {"spectral.range_um", "0 < lo < hi"});
+  refused("key", s + "elements = 3\n", {"spectral.elements", "unknown key"});
+  refused("temperature", edited("class = \"O5V\"", "temperature_K = 0") + "[spectral]\n",
+          {"stars.0.temperature_K", "> 0"});
+  refused("light_range", edited("class = \"O5V\"", "temperature_K = 90000") + "[spectral]\nmethod = \"light_density\"\n",
+          {"stars.0.temperature_K", "2000 to 60000"});
+  refused("albedo_per_band", edited("albedo = 0.6", "albedo = { B = 0.5, V = 0.6, R = 0.6 }") + "[spectral]\n",
+          {"dust.albedo", "one albedo"});
+  refused("override", kBase, {"spectral.basis", "1..16", "override 'spectral.basis=0'"}, {"spectral.basis=0"});
 }
 
 const char* kAxial = R"(

@@ -5,13 +5,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
-# astropy (PyPI) for the FITS test validation.fits_astropy, in a virtual
-# environment inside the build folder, installed once and reused.
+# astropy and pytest (PyPI) for the FITS test validation.fits_astropy and the
+# Python module's tests (python.module), in a virtual environment inside the
+# build folder, installed once and reused.
 py=build/pyenv/bin/python
-if ! "$py" -c "import astropy, numpy" 2>/dev/null; then
+if ! "$py" -c "import astropy, numpy, pytest" 2>/dev/null; then
   /usr/bin/python3 -m venv build/pyenv
-  "$py" -m pip install --quiet --disable-pip-version-check astropy ||
-    echo "test.sh: warning: astropy could not be installed from PyPI; validation.fits_astropy will report a skip" >&2
+  "$py" -m pip install --quiet --disable-pip-version-check astropy pytest ||
+    echo "test.sh: warning: astropy or pytest could not be installed from PyPI; validation.fits_astropy and python.module will report a skip" >&2
 fi
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DNEBULA_PYTHON="$PWD/$py"
 cmake --build build -j"$(nproc)"

@@ -68,6 +68,9 @@ struct PathScene {
   int roulette_start = 3;  // collisions before Russian roulette plays
   bool exact_transmittance = false;  // NEE: exact DDA sum over voxels instead of ratio tracking
   bool equiangular = false;  // NEE also from equiangular samples towards each star, MIS with the collisions
+  // Pixel-area sampling: sample k lies in stratum k mod side^2 of a side x
+  // side grid over the pixel, at a uniform point in it (1: the pixel's centre).
+  int pixel_side = 1;
 };
 
 struct PathCounters {
@@ -223,16 +226,27 @@ NEBULA_HD float trace_path(const PathScene& s, int b, Vec3 origin, Vec3 dir, Rng
 }
 
 // All samples of pixel (x, y): mean and variance of the mean per band
-// (exposure applied), from double sums. spp >= 2.
+// (exposure applied), from double sums. spp >= 2, a multiple of the strata
+// (pixel_side^2): stratified samples make this variance an upper bound.
 NEBULA_HD void trace_pixel(const PathScene& s, const Camera& camera, float exposure, int x, int y, int spp,
                            float* mean, float* variance, PathCounters& c) {
   for (int b = 0; b < s.n_bands; ++b) mean[b] = variance[b] = 0.0f;
   Vec3 origin, dir;
-  if (!camera.ray(x, y, origin, dir)) return;
+  const bool centre = camera.ray(x, y, origin, dir);
+  if (!centre && s.pixel_side == 1) return;
   const uint32_t pixel = static_cast<uint32_t>(y) * static_cast<uint32_t>(camera.width) + static_cast<uint32_t>(x);
+  const int strata = s.pixel_side * s.pixel_side;
   for (int b = 0; b < s.n_bands; ++b) {
     double sum = 0.0, sum2 = 0.0;
     for (int k = 0; k < spp; ++k) {
+      if (strata > 1) {
+        // The same sub-pixel point in every band (its own stream, band 0xFF).
+        PathRng jitter(s.seed, pixel, static_cast<uint32_t>(k), 0xFFu);
+        const int stratum = k % strata;
+        const float fx = x + (stratum % s.pixel_side + jitter.next()) / s.pixel_side;
+        const float fy = y + (stratum / s.pixel_side + jitter.next()) / s.pixel_side;
+        if (!camera.ray_through(fx, fy, origin, dir)) continue;  // outside the dome: no light (a zero sample)
+      }
       PathRng rng(s.seed, pixel, static_cast<uint32_t>(k), static_cast<uint32_t>(b));
       const double v = trace_path(s, b, origin, dir, rng, c);
       sum += v;

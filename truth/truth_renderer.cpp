@@ -27,6 +27,11 @@ void validate(const TruthInputs& in) {
   for (const StarLight& s : in.stars)
     if (s.power.size() != in.bands.size()) throw Error("truth: a star lacks band powers");
   if (in.spp < 2) throw ParameterError("spp", "at least 2 samples per pixel (the variance needs two)");
+  if (in.pixel_side < 1 || in.pixel_side > 16) throw ParameterError("pixel_side", "must be 1 to 16");
+  if (in.spp % (in.pixel_side * in.pixel_side) != 0)
+    throw ParameterError("spp", std::to_string(in.spp) + " is not a multiple of the " +
+                                    std::to_string(in.pixel_side * in.pixel_side) +
+                                    " strata of render.samples_per_pixel (each stratum gets as many samples)");
   if (in.max_orders < 0) throw ParameterError("max_orders", "must be 0 (all) or positive");
   if (in.roulette_start < 1) throw ParameterError("roulette_start", "must be at least 1");
   if (in.majorant_block < 1 || in.majorant_block > 256) throw ParameterError("majorant_block", "must be 1 to 256 voxels");

@@ -31,6 +31,7 @@ struct TruthInputs {
   Camera camera;
   float exposure = 1.0f;
   int spp = 16;            // samples per pixel and band, >= 2
+  int pixel_side = 1;      // pixel-area sampling: side x side strata (1: the pixel's centre); spp a multiple of side^2
   uint64_t seed = 1;
   int max_orders = 0;      // 0: all orders (the truth)
   int roulette_start = 3;
@@ -83,6 +84,7 @@ PathScene assemble_path_scene(const TruthInputs& in, const MajorantGrid& majoran
   s.n_stars = static_cast<int>(in.stars.size());
   s.seed = in.seed;
   s.max_orders = in.max_orders;
+  s.pixel_side = in.pixel_side;
   s.roulette_start = in.roulette_start;
   s.exact_transmittance = in.exact_transmittance;
   s.equiangular = in.equiangular;

@@ -7,28 +7,22 @@
 
 namespace nebula::viewer {
 
-Rgba8 display_image(const Image& image, double exposure, const DisplaySettings& display) {
-  std::vector<int> source;
-  if (image.bands.size() == 1) {
-    source = {0, 0, 0};
-  } else {
-    for (const char* band : {"R", "V", "B"}) {
-      const auto at = std::find(image.bands.begin(), image.bands.end(), band);
-      source.push_back(at == image.bands.end() ? -1 : int(at - image.bands.begin()));
-    }
-  }
+Rgba8 display_image(const Image& image, double exposure, const DisplaySettings& display, const ImageMetadata& metadata) {
+  const std::vector<PngColour> colours = png_colours(image, metadata);
   const size_t plane = image.plane_size();
-  if (display.auto_exposure) {
-    // The bands shown, once each (the PNG writer's choice: core/display.h).
-    std::vector<float> shown;
-    std::vector<int> distinct;
-    for (int s : source)
-      if (s >= 0 && std::find(distinct.begin(), distinct.end(), s) == distinct.end()) distinct.push_back(s);
-    for (int s : distinct)
-      shown.insert(shown.end(), image.pixels.begin() + std::ptrdiff_t(size_t(s) * plane),
-                   image.pixels.begin() + std::ptrdiff_t(size_t(s + 1) * plane));
-    exposure = auto_exposure_of(shown, display, exposure);
-  }
+  const bool grey = image.bands.size() == 1;
+  const int channels = grey ? 1 : 3;
+  std::vector<float> shown(plane * size_t(channels));
+  for (size_t i = 0; i < plane; ++i)
+    for (int c = 0; c < channels; ++c) {
+      float v = 0.0f;
+      for (size_t b = 0; b < colours.size(); ++b) {
+        const PngColour& w = colours[b];
+        v += (c == 0 ? w.red : c == 1 ? w.green : w.blue) * image.pixels[b * plane + i];
+      }
+      shown[size_t(c) * plane + i] = v;
+    }
+  if (display.auto_exposure) exposure = auto_exposure_of(shown, display, exposure);
   Rgba8 out;
   out.width = image.width;
   out.height = image.height;
@@ -36,8 +30,7 @@ Rgba8 display_image(const Image& image, double exposure, const DisplaySettings& 
   out.pixels.assign(plane * 4, 255);
   for (size_t i = 0; i < plane; ++i)
     for (int c = 0; c < 3; ++c)
-      out.pixels[i * 4 + size_t(c)] =
-          source[size_t(c)] < 0 ? 0 : display_level(image.pixels[size_t(source[size_t(c)]) * plane + i], exposure, display);
+      out.pixels[i * 4 + size_t(c)] = display_level(shown[size_t(grey ? 0 : c) * plane + i], exposure, display);
   return out;
 }
 

@@ -1,13 +1,14 @@
 #pragma once
 // A rendered frame as the viewer shows it: 8-bit RGBA through the same
-// display transform as a PNG file (core/display.h, imageio/tone_map.h): red,
-// green, blue from the bands R, V, B (one grey band as grey), with the auto
-// exposure chosen from the bands shown, as the PNG writer chooses it.
+// colours and display transform as a PNG file (imageio/image_output.h's
+// png_colours, core/display.h, imageio/tone_map.h), with the auto exposure
+// chosen from the channels shown, as the PNG writer chooses it.
 #include <cstdint>
 #include <vector>
 
 #include "core/display.h"
 #include "core/image.h"
+#include "imageio/image_output.h"
 
 namespace nebula::viewer {
 
@@ -17,6 +18,7 @@ struct Rgba8 {
   double exposure = 1;          // the exposure used (the auto one when asked)
 };
 
-Rgba8 display_image(const Image& image, double exposure, const DisplaySettings& display);
+// `metadata` names the bands' pivot wavelengths for bands other than B, V, R (rendered frames carry them).
+Rgba8 display_image(const Image& image, double exposure, const DisplaySettings& display, const ImageMetadata& metadata);
 
 }  // namespace nebula::viewer

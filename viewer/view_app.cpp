@@ -420,7 +420,7 @@ int run(const Args& args) {
     static DisplaySettings shown_display;
     static double shown_exposure = 0;
     if (shown && (new_pixels || !(shown_display == view.display) || shown_exposure != view.camera.exposure)) {
-      shown_rgba = display_image(shown->image, view.camera.exposure, view.display);
+      shown_rgba = display_image(shown->image, view.camera.exposure, view.display, shown->metadata);
       if (!gpu_shown) texture.upload(shown_rgba);
       shown_display = view.display;
       shown_exposure = view.camera.exposure;
@@ -429,7 +429,7 @@ int run(const Args& args) {
     // The ground truth, accumulated by the session while the camera rests, shown instead when asked.
     std::optional<TruthFrame> truth = truth_on ? session.truth() : std::nullopt;
     if (show_truth && truth && !gpu_shown && (truth->passes != truth_shown_passes || new_pixels)) {
-      texture.upload(display_image(truth->mean, view.camera.exposure, view.display));
+      texture.upload(display_image(truth->mean, view.camera.exposure, view.display, shown ? shown->metadata : ImageMetadata{}));
       truth_shown_passes = truth->passes;
     } else if (!show_truth && truth_shown_passes >= 0 && shown) {
       texture.upload(shown_rgba);
@@ -646,7 +646,7 @@ int run(const Args& args) {
         std::optional<Frame> f = session.take_frame();
         if (f) {
           full = *f;
-          shown_rgba = display_image(f->image, view.camera.exposure, view.display);
+          shown_rgba = display_image(f->image, view.camera.exposure, view.display, f->metadata);
           texture.upload(shown_rgba);
           shown = std::move(f);
         }

@@ -60,7 +60,7 @@ std::vector<std::string> SceneSource::overrides() const {
 Scene SceneSource::load() const { return load_scene_text(text_, name_, base_dir_, overrides()); }
 
 Scene SceneSource::load_reusing(const Scene& previous) const {
-  return load_scene_text_reusing_grids(text_, name_, base_dir_, overrides(), previous);
+  return load_scene_text(text_, name_, base_dir_, overrides(), &previous);
 }
 
 std::string toml_number(double v) {
@@ -110,11 +110,15 @@ struct Session::Baked {
   RenderOptions options;
   PreparedGrid prepared;  // built in place: it points into itself and into *scene
   Baked(std::shared_ptr<const Scene> s, const RenderOptions& o)
-      : scene(std::move(s)), options(o), prepared(scene->axial ? PreparedGrid{} : prepare_grid(*scene, o)) {}
+      : scene(std::move(s)), options(o), prepared(per_frame() ? PreparedGrid{} : prepare_grid(*scene, o)) {}
+
+  // An axial map bakes with its render (cheap beside a 3D grid's bake); the
+  // spectral renderer has no bake to keep.
+  bool per_frame() const { return scene->axial.has_value() || scene->spectral.has_value(); }
 
   RenderOutput render(const CameraSettings& camera) const {
-    if (!scene->axial) return render_prepared(prepared, camera);
-    Scene copy = *scene;  // an axial map bakes with its render (cheap beside a 3D grid's bake)
+    if (!per_frame()) return render_prepared(prepared, camera);
+    Scene copy = *scene;
     copy.camera = camera;
     return render_scene(copy, options);
   }
@@ -204,7 +208,7 @@ SceneSource Session::source() const {
 
 std::shared_ptr<const PreparedGrid> Session::prepared() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!baked_ || baked_->scene->axial || baked_->scene->pyramid_levels > 0 ||
+  if (!baked_ || baked_->per_frame() || baked_->scene->pyramid_levels > 0 ||
       baked_->scene->multiple_scattering == MultipleScattering::Pyramid)
     return nullptr;
   return std::shared_ptr<const PreparedGrid>(baked_, &baked_->prepared);

@@ -183,7 +183,7 @@ TEST_F(ViewerSession, TheWindowShowsWhatAPngHolds) {
   DisplaySettings d;
   d.stretch = Stretch::Asinh;
   d.auto_exposure = true;
-  const Rgba8 rgba = display_image(f.image, 0.02, d);
+  const Rgba8 rgba = display_image(f.image, 0.02, d, f.metadata);
   ImageMetadata m = f.metadata;
   m.display = d;
   m.exposure = 0.02;

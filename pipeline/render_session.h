@@ -1,0 +1,47 @@
+#pragma once
+// A scene rendered again and again under edits: parameter sweeps (`nebula
+// sweep`), the Python module, a viewer. The session keeps the last scene's
+// grids and its view-independent preparation; each render applies its
+// overrides to the scene text and redoes only what they change: the grids
+// only when [density], [emission] or the bands change, the star bakes only
+// when the grid or the stars' positions do, the diffuse field when the dust,
+// the tables or the stars' light do (prepare_grid's re-preparing overload).
+// A camera edit costs the frame alone.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pipeline/render_scene.h"
+
+namespace nebula {
+
+class RenderSession {
+ public:
+  // A scene file, or TOML text (`name` in messages, `base_dir` for its
+  // relative paths), with overrides applied to every render.
+  static RenderSession from_file(const std::string& path, std::vector<std::string> overrides, RenderOptions options);
+  static RenderSession from_text(std::string text, std::string name, std::string base_dir,
+                                 std::vector<std::string> overrides, RenderOptions options);
+
+  // The scene under the session's overrides, then these ("KEY=VALUE", as
+  // load_scene takes them). Errors name the scene and the key.
+  const Scene& load(const std::vector<std::string>& overrides = {});
+  // The fast render of that scene (render_scene's image, metadata and report).
+  RenderOutput render(const std::vector<std::string>& overrides = {});
+  // The ground truth of that scene (truth_scene; nothing is reused: it bakes nothing).
+  TruthRenderOutput truth(const std::vector<std::string>& overrides, const TruthOptions& options);
+
+  const RenderOptions& options() const { return options_; }
+  RenderOptions& options() { return options_; }
+
+ private:
+  RenderSession() = default;
+  std::string text_, name_, base_dir_;
+  std::vector<std::string> overrides_;
+  RenderOptions options_;
+  // The last scene (on the heap: the preparation points into it) and its preparation.
+  std::unique_ptr<Scene> scene_, retired_;
+  std::unique_ptr<PreparedGrid> prepared_;
+};
+
+}  // namespace nebula

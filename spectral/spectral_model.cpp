@@ -1,0 +1,283 @@
+#include "spectral/spectral_model.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.h"
+#include "illumination/filters.h"
+
+namespace nebula::spectral {
+namespace {
+
+constexpr double kTransmittanceCut = 9.210340371976184;  // -ln(1e-4), the marcher's cut
+constexpr double kMinTemperature = 2000.0, kMaxTemperature = 60000.0;
+
+// 5-point Gauss-Legendre on [a, b].
+template <class F>
+double gauss5(F&& f, double a, double b) {
+  static const double x[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640};
+  static const double w[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
+                              0.2369268850561891};
+  const double m = 0.5 * (a + b), h = 0.5 * (b - a);
+  double s = 0.0;
+  for (int i = 0; i < 5; ++i) s += w[i] * f(m + h * x[i]);
+  return s * h;
+}
+
+// V-filter averages of 1/lambda and of the law (kappa's normalisations).
+double mean_over_v(const std::function<double(double)>& f) {
+  const Passband v = load_filter("V");
+  const double num = passband_integral(v, [&](double nm) { return f(nm / 1000.0); }, kPassbandSubdivisions);
+  const double den = passband_integral(v, [](double) { return 1.0; }, kPassbandSubdivisions);
+  return num / den;
+}
+
+}  // namespace
+
+double SpectralStar::shape(double lambda) const {
+  if (table) return (*table)(lambda);
+  return wien ? wien_shape(lambda, temperature_K) : planck_shape(lambda, temperature_K);
+}
+
+double SpectralModel::kappa_at(double lambda) const {
+  if (settings.attenuation == Attenuation::Inverse) return C_T / lambda;
+  return extinction_ratio_at(lambda * 1000.0, settings.R_V, settings.law) / C_T;
+}
+
+SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Passband>>& filters,
+                                   const std::vector<SpectralStar>& stars, const SpectralSettings& settings) {
+  if (filters.empty()) throw Error("spectral: no filter");
+  if (settings.basis < 1 || settings.basis > 16)
+    throw Error("spectral: the basis size is " + std::to_string(settings.basis) + "; must be in 1..16");
+  if (!(settings.max_depth >= 0 && std::isfinite(settings.max_depth)))
+    throw Error("spectral: max_depth is " + to_text(settings.max_depth) + "; must be >= 0 (0: automatic)");
+  if (!(settings.fit_depth >= 0 && std::isfinite(settings.fit_depth)))
+    throw Error("spectral: fit_depth is " + to_text(settings.fit_depth) + "; must be >= 0 (0: automatic)");
+  if (settings.wavelengths < 2)
+    throw Error("spectral: wavelengths is " + std::to_string(settings.wavelengths) + "; must be at least 2");
+  for (const SpectralStar& s : stars) {
+    if (!s.table && !(s.temperature_K > 0.0 && std::isfinite(s.temperature_K)))
+      throw Error("spectral: a star temperature of " + to_text(s.temperature_K) + " K; must be positive");
+    if (s.table && settings.method == SpectralMethod::LightBasis)
+      throw Error("spectral: the light-density basis spans black bodies; star spectrum '" + s.table->name +
+                  "' is tabulated (use the projection method)");
+  }
+  if (settings.method == SpectralMethod::Analytic && settings.attenuation != Attenuation::Inverse)
+    throw Error("spectral: the analytic integral needs the attenuation C_T / lambda (attenuation = \"inverse\")");
+  SpectralModel m;
+  m.settings = settings;
+  m.n_stars = int(stars.size());
+  m.stars = stars;
+  m.lo_um = 1e30;
+  m.hi_um = 0;
+  for (const auto& [name, band] : filters) {
+    FitReport r;
+    m.filter_names.push_back(name);
+    m.filters.push_back(fit_passband(band, 2e-3, &r));
+    m.fits.push_back(r);
+    m.lo_um = std::min(m.lo_um, band.wavelength_nm.front() / 1000.0);
+    m.hi_um = std::max(m.hi_um, band.wavelength_nm.back() / 1000.0);
+  }
+  if (settings.attenuation == Attenuation::Inverse) {
+    m.C_T = 1.0 / mean_over_v([](double l) { return 1.0 / l; });
+  } else {
+    m.C_T = mean_over_v([&](double l) { return extinction_ratio_at(l * 1000.0, settings.R_V, settings.law); });
+    (void)m.kappa_at(m.lo_um);  // a filter outside the law's range is refused here, naming the wavelength
+    (void)m.kappa_at(m.hi_um);
+  }
+  if (settings.lo_um > 0 || settings.hi_um > 0) {
+    if (!(settings.lo_um > 0 && settings.hi_um > settings.lo_um && settings.lo_um <= m.lo_um && settings.hi_um >= m.hi_um))
+      throw Error("spectral: the wavelength range [" + to_text(settings.lo_um) + ", " + to_text(settings.hi_um) +
+                  "] um must hold every filter (they span [" + to_text(m.lo_um) + ", " + to_text(m.hi_um) + "] um)");
+    m.lo_um = settings.lo_um;
+    m.hi_um = settings.hi_um;
+  }
+  m.grid = WavelengthGrid::uniform(m.lo_um, m.hi_um, settings.grid_nodes);
+  double kappa_min = 1e30;
+  for (double l : m.grid.lambda) {
+    m.kappa_grid.push_back(m.kappa_at(l));
+    kappa_min = std::min(kappa_min, m.kappa_grid.back());
+  }
+  m.max_eye_depth = float(kTransmittanceCut / kappa_min);
+  m.max_depth = settings.max_depth > 0 ? settings.max_depth : kTransmittanceCut / kappa_min;
+  m.fit_depth = settings.fit_depth > 0 ? settings.fit_depth : std::min(kFitDepth, m.max_depth);
+  if (!(m.fit_depth <= m.max_depth))
+    throw Error("spectral: fit_depth " + to_text(m.fit_depth) + " exceeds max_depth " + to_text(m.max_depth));
+  const int F = int(filters.size()), S = int(stars.size()), N = settings.basis;
+  std::vector<std::vector<double>> S_on_grid(F);
+  for (int f = 0; f < F; ++f)
+    for (double l : m.grid.lambda) S_on_grid[f].push_back(m.filters[f](l));
+
+  switch (settings.method) {
+    case SpectralMethod::Double: {
+      if (F > kMaxAccumulators) throw Error("spectral: at most 64 filters");
+      m.n_acc = F;
+      const int M = settings.wavelengths;
+      const double step = (m.hi_um - m.lo_um) / M;
+      for (int i = 0; i < M; ++i) m.kappa.push_back(float(m.kappa_at(m.lo_um + (i + 0.5) * step)));
+      for (int s = 0; s < S; ++s)
+        for (int f = 0; f < F; ++f)
+          for (int i = 0; i < M; ++i) {
+            const double l = m.lo_um + (i + 0.5) * step;
+            m.q.push_back(float(m.filters[f](l) * m.kappa_at(l) * stars[s].shape(l) * step));
+          }
+      break;
+    }
+    case SpectralMethod::Analytic: {
+      if (F > kMaxAccumulators) throw Error("spectral: at most 64 filters");
+      m.n_acc = F;
+      for (const FitReport& r : m.fits) m.segments = std::max(m.segments, r.segments);
+      for (int s = 0; s < S; ++s)
+        for (int f = 0; f < F; ++f) {
+          const PiecewisePolynomial& filter = m.filters[f];
+          const PiecewisePolynomial p = fit_function([&](double l) { return filter(l) * stars[s].shape(l); },
+                                                     filter.breaks.front(), filter.breaks.back(), m.segments);
+          m.breaks.insert(m.breaks.end(), p.breaks.begin(), p.breaks.end());
+          m.coefficients.insert(m.coefficients.end(), p.coefficients.begin(), p.coefficients.end());
+        }
+      break;
+    }
+    case SpectralMethod::Projection:
+    case SpectralMethod::LightBasis: {
+      const bool light = settings.method == SpectralMethod::LightBasis;
+      constexpr int kFamilyDepths = 128;
+      const int family_temperatures = light ? 16 : 1;
+      std::vector<std::vector<double>> family;
+      const auto temperature_at = [](double u, int n) {
+        return std::exp(std::log(kMinTemperature) + u * (std::log(kMaxTemperature) - std::log(kMinTemperature)) /
+                                                        std::max(n - 1, 1));
+      };
+      for (int t = 0; t < family_temperatures; ++t)
+        for (int d = 0; d < kFamilyDepths; ++d) {
+          const double a = m.fit_depth * d / (kFamilyDepths - 1);
+          const double T = temperature_at(t, family_temperatures);
+          // Light-density members: the star's shape scaled to unit norm on the grid, so
+          // that hot and cool stars weigh alike; attenuation keeps its absolute weight.
+          std::vector<double> shape(m.grid.lambda.size(), 1.0);
+          if (light) {
+            for (size_t i = 0; i < shape.size(); ++i) shape[i] = planck_shape(m.grid.lambda[i], T);
+            const double norm = m.grid.norm(shape);
+            for (double& v : shape) v /= norm;
+          }
+          std::vector<double> f;
+          for (size_t i = 0; i < m.grid.lambda.size(); ++i) f.push_back(shape[i] * std::exp(-m.kappa_grid[i] * a));
+          if (settings.relative) {
+            const double norm = m.grid.norm(f);
+            for (double& v : f) v /= norm;
+          }
+          family.push_back(std::move(f));
+        }
+      m.basis = greedy_basis(m.grid, family, N, 0);
+      for (int k : m.basis.chosen) {
+        m.element_depth.push_back(m.fit_depth * (k % kFamilyDepths) / (kFamilyDepths - 1));
+        if (light) m.element_temperature_K.push_back(temperature_at(k / kFamilyDepths, family_temperatures));
+      }
+      const int n = m.basis.size();  // may stop short when the family is exhausted
+      m.settings.basis = n;
+      m.n_temperature = light ? settings.temperature_nodes : 1;
+      m.n_acc = light ? n : S * n;
+      if (m.n_acc > kMaxAccumulators)
+        throw Error("spectral: " + std::to_string(S) + " stars x " + std::to_string(n) +
+                    " basis elements exceed the 64 accumulators of a ray (use the light-density basis)");
+      const int D = settings.depth_nodes;
+      m.depth_step = float(m.max_depth / (D - 1));
+      std::vector<double> f(m.grid.lambda.size());
+      for (int t = 0; t < m.n_temperature; ++t) {
+        const double T = temperature_at(t, m.n_temperature);
+        for (int d = 0; d < D; ++d) {
+          for (size_t i = 0; i < f.size(); ++i)
+            f[i] = (light ? planck_shape(m.grid.lambda[i], T) : 1.0) * std::exp(-m.kappa_grid[i] * d * m.depth_step);
+          for (double c : settings.relative ? project_relative(m.grid, m.basis, f) : project(m.grid, m.basis, f))
+            m.coeff.push_back(float(c));
+        }
+      }
+      for (const SpectralStar& s : stars) {
+        const double u = (std::log(s.temperature_K) - std::log(kMinTemperature)) /
+                         (std::log(kMaxTemperature) - std::log(kMinTemperature)) * (m.n_temperature - 1);
+        if (light && (u < 0 || u > m.n_temperature - 1))
+          throw Error("spectral: star temperature " + to_text(s.temperature_K) +
+                      " K is outside the light-density basis' range [2000, 60000] K");
+        m.temperature_u.push_back(float(std::clamp(u, 0.0, double(m.n_temperature - 1))));
+      }
+      set_filters(m, filters);
+      return m;
+    }
+  }
+  m.resolve.assign(size_t(F) * m.n_acc, 0.0f);
+  for (int f = 0; f < F; ++f) m.resolve[size_t(f) * m.n_acc + f] = 1.0f;
+  return m;
+}
+
+void set_filters(SpectralModel& m, const std::vector<std::pair<std::string, Passband>>& filters) {
+  const bool light = m.settings.method == SpectralMethod::LightBasis;
+  if (!light && m.settings.method != SpectralMethod::Projection)
+    throw Error("spectral: filters change on a basis only (the projection or light-density method)");
+  m.filter_names.clear();
+  m.filters.clear();
+  m.fits.clear();
+  for (const auto& [name, band] : filters) {
+    const double lo = band.wavelength_nm.front() / 1000.0, hi = band.wavelength_nm.back() / 1000.0;
+    if (lo < m.lo_um - 1e-12 || hi > m.hi_um + 1e-12)
+      throw Error("spectral: filter '" + name + "' spans [" + to_text(lo) + ", " + to_text(hi) +
+                  "] um, outside the basis' range [" + to_text(m.lo_um) + ", " + to_text(m.hi_um) + "] um");
+    FitReport r;
+    m.filter_names.push_back(name);
+    m.filters.push_back(fit_passband(band, 2e-3, &r));
+    m.fits.push_back(r);
+  }
+  const int F = int(filters.size()), n = m.basis.size(), S = int(m.stars.size());
+  const size_t G = m.grid.lambda.size();
+  m.resolve.assign(size_t(F) * m.n_acc, 0.0f);
+  for (int fi = 0; fi < F; ++fi)
+    for (int s = 0; s < (light ? 1 : S); ++s)
+      for (int j = 0; j < n; ++j) {
+        double sum = 0.0;
+        for (size_t i = 0; i < G; ++i) {
+          const double l = m.grid.lambda[i];
+          sum += m.grid.weight[i] * m.filters[fi](l) * m.kappa_grid[i] * (light ? 1.0 : m.stars[s].shape(l)) *
+                 m.basis.phi[j][i];
+        }
+        m.resolve[size_t(fi) * m.n_acc + s * n + j] = float(sum);
+      }
+}
+
+SpectralSceneView view_of(const SpectralModel& m) {
+  SpectralSceneView v;
+  v.method = m.settings.method;
+  v.n_acc = m.n_acc;
+  v.max_eye_depth = m.max_eye_depth;
+  v.n_lambda = int(m.kappa.size());
+  v.kappa = m.kappa.data();
+  v.q = m.q.data();
+  v.C_T = m.C_T;
+  v.breaks = m.breaks.data();
+  v.coefficients = m.coefficients.data();
+  v.segments = m.segments;
+  v.degree = kMaxPolynomialDegree;
+  v.n_basis = m.basis.size();
+  v.n_depth = m.settings.depth_nodes;
+  v.n_temperature = m.n_temperature;
+  v.depth_step = m.depth_step;
+  v.coeff = m.coeff.data();
+  return v;
+}
+
+double reference_integral(const SpectralModel& m, int filter, const SpectralStar& star, double D) {
+  const PiecewisePolynomial& S = m.filters[size_t(filter)];
+  double sum = 0.0;
+  for (int seg = 0; seg < S.segments(); ++seg) {
+    const double a = S.breaks[seg], b = S.breaks[seg + 1];
+    for (int k = 0; k < 8; ++k) {
+      const double lo = a + (b - a) * k / 8, hi = a + (b - a) * (k + 1) / 8;
+      sum += gauss5(
+          [&](double l) {
+            const double kappa = m.kappa_at(l);
+            return S(l) * kappa * star.shape(l) * std::exp(-kappa * D);
+          },
+          lo, hi);
+    }
+  }
+  return sum;
+}
+
+}  // namespace nebula::spectral

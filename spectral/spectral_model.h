@@ -1,0 +1,112 @@
+#pragma once
+// Everything the spectral marcher reads besides the grid and the bakes, built
+// on the host from the filters, the stars' spectra and the dust law: the
+// wavelength samples of the double integral, the filter x star polynomials of
+// the analytic integral, the greedy bases and their coefficient tables, and
+// the resolve matrix that turns a ray's accumulators into one value per filter.
+#include <string>
+#include <vector>
+
+#include "illumination/extinction.h"
+#include "illumination/passband.h"
+#include "spectral/basis.h"
+#include "spectral/piecewise_polynomial.h"
+#include "spectral/spectra.h"
+#include "spectral/spectral_march.h"
+
+namespace nebula::spectral {
+
+// kappa(lambda) = tau(lambda) / tau_V: the report's C_T / lambda, or the
+// scene's CCM89 / O'Donnell law; both normalised so that their average over
+// the V filter is 1 (tau_V is the V-band depth, DESIGN.md section 3).
+enum class Attenuation { Inverse, Law };
+
+// The default family range: V-band optical paths up to 8 (transmission 3e-4).
+constexpr double kFitDepth = 8.0;
+
+struct SpectralSettings {
+  SpectralMethod method = SpectralMethod::Projection;
+  int basis = 4;            // elements of the greedy basis (Projection, LightBasis), 1..16
+  int wavelengths = 20;     // samples of the double integral over the filters' span
+  Attenuation attenuation = Attenuation::Inverse;
+  double R_V = 5.0;
+  ExtinctionLaw law = ExtinctionLaw::CCM89;
+  // The coefficient table's optical paths D in [0, max_depth] (V band); a pair
+  // past it is dropped. 0: where the longest wavelength is attenuated to the
+  // marcher's cut, e^(-kappa_min D) = 1e-4.
+  double max_depth = 0;
+  // The basis family's optical paths a in [0, fit_depth] (V band), where the
+  // basis is chosen to be accurate; past it the error grows (bounded by the
+  // relative projection). 0: the default kFitDepth.
+  double fit_depth = 0;
+  // The error measure of the greedy and the coefficients. Relative (ours): each
+  // member scaled to unit norm for the greedy, coefficients of least relative
+  // error (project_relative). Absolute (the report's): members as they are,
+  // orthogonal projection; its error is absolute, so light that arrives through
+  // long optical paths (dim, but all a pixel behind dense dust receives) is
+  // poorly represented (docs/spectral.md).
+  bool relative = true;
+  int depth_nodes = 2048;       // coefficient table over a
+  int temperature_nodes = 48;   // LightBasis: table over log T in [2000, 60000] K
+  int grid_nodes = 1024;        // wavelength grid of the inner products
+  // The basis' wavelength range (um); 0: the filters' span. A range fixed
+  // ahead lets set_filters change filters with the same basis and tables.
+  double lo_um = 0, hi_um = 0;
+};
+
+struct SpectralStar {
+  double temperature_K = 5772;
+  const TabulatedSpectrum* table = nullptr;  // overrides the black body (not with LightBasis)
+  bool wien = false;                         // Wien's approximation instead of Planck
+  double shape(double lambda_um) const;
+};
+
+struct SpectralModel {
+  SpectralSettings settings;
+  std::vector<std::string> filter_names;
+  std::vector<PiecewisePolynomial> filters;  // fitted S_f
+  std::vector<FitReport> fits;
+  double lo_um = 0, hi_um = 0;  // the filters' span
+  double C_T = 0;               // kappa = C_T / lambda (Inverse)
+  WavelengthGrid grid;
+  std::vector<double> kappa_grid;  // kappa on the grid
+  GreedyBasis basis;
+  // The chosen members: their optical path a (V band) and, for the
+  // light-density basis, their star temperature (K).
+  std::vector<double> element_depth, element_temperature_K;
+  double max_depth = 0, fit_depth = 0;
+  int n_stars = 0;
+  std::vector<SpectralStar> stars;
+  // Arrays of the view (host copies).
+  int n_acc = 0;
+  std::vector<float> kappa, q, coeff, temperature_u;
+  std::vector<double> breaks, coefficients;
+  int segments = 0;
+  float depth_step = 1;
+  int n_temperature = 1;
+  float max_eye_depth = 1e30f;
+  std::vector<float> resolve;  // [filter][acc]
+  double kappa_at(double lambda_um) const;
+};
+
+// Errors (ParameterError-free: callers name their keys): no filter, a filter
+// outside the law's range, basis < 1 or > 16, wavelengths < 2, a temperature
+// not positive, Analytic with the Law attenuation, LightBasis with a
+// tabulated star.
+SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Passband>>& filters,
+                                   const std::vector<SpectralStar>& stars, const SpectralSettings& settings);
+
+// New filters on the same basis and tables (Projection, LightBasis): only the
+// resolve matrix changes, no march or bake (Barrès' filters changed at run
+// time). Refuses a filter outside the basis' wavelength range.
+void set_filters(SpectralModel& m, const std::vector<std::pair<std::string, Passband>>& filters);
+
+// The view of a model (pointers into it; stars and grid filled by the renderer).
+SpectralSceneView view_of(const SpectralModel& m);
+
+// The exact integral of S_f kappa s e^(-kappa D) over lambda for one filter
+// and star (adaptive Gauss-Legendre on the fitted S_f): the reference the
+// methods are measured against.
+double reference_integral(const SpectralModel& m, int filter, const SpectralStar& star, double D);
+
+}  // namespace nebula::spectral

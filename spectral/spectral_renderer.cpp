@@ -1,0 +1,79 @@
+#include "spectral/spectral_renderer.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <string>
+
+#include "core/error.h"
+
+namespace nebula::spectral {
+namespace {
+void check(const SpectralRenderInputs& in) {
+  if (!in.density || !in.model) throw Error("spectral render: no density grid or model");
+  if (int(in.lights.size()) != in.model->n_stars)
+    throw Error("spectral render: the model was built for " + std::to_string(in.model->n_stars) + " stars, got " +
+                std::to_string(in.lights.size()));
+  for (const SpectralLight& l : in.lights)
+    if (!l.depth_v || l.depth_v->size() != in.density->shape.count())
+      throw Error("spectral render: a star has no baked depth for this grid");
+}
+}  // namespace
+
+Image render_spectral(const SpectralRenderInputs& in, Backend backend, double* seconds) {
+  check(in);
+  return backend == Backend::Cuda ? render_spectral_cuda(in, seconds) : render_spectral_cpu(in, seconds);
+}
+
+Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds) {
+  check(in);
+  const SpectralModel& m = *in.model;
+  std::vector<SpectralStarView> stars;
+  for (size_t k = 0; k < in.lights.size(); ++k)
+    stars.push_back({in.lights[k].position, float(in.lights[k].luminosity_lsun), in.lights[k].depth_v->data(),
+                     m.temperature_u.empty() ? 0.0f : m.temperature_u[k]});
+  SpectralSceneView view = view_of(m);
+  view.density = in.density->view();
+  view.stars = stars.data();
+  view.n_stars = int(stars.size());
+  view.albedo = in.albedo;
+  view.g = in.g;
+  view.footprint = in.camera.footprint();
+  std::vector<std::string> names;
+  for (int k = 0; k < m.n_acc; ++k) names.push_back("acc" + std::to_string(k));
+  Image image(in.camera.width, in.camera.height, names);
+  const auto start = std::chrono::steady_clock::now();
+  dispatch_method(m.settings.method, [&](auto method) {
+    tbb::parallel_for(tbb::blocked_range<int>(0, in.camera.height), [&](const auto& rows) {
+      float acc[kMaxAccumulators];
+      for (int y = rows.begin(); y != rows.end(); ++y)
+        for (int x = 0; x < in.camera.width; ++x) {
+          Vec3 origin, dir;
+          if (!in.camera.ray(x, y, origin, dir)) continue;
+          march_spectral<method()>(view, origin, dir, acc);
+          for (int k = 0; k < m.n_acc; ++k) image.at(k, x, y) = acc[k];
+        }
+    });
+  });
+  if (seconds) *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return image;
+}
+
+Image resolve_filters(const Image& acc, const SpectralModel& m, float exposure) {
+  Image out(acc.width, acc.height, m.filter_names);
+  const size_t plane = acc.plane_size();
+  const int F = int(m.filter_names.size());
+  tbb::parallel_for(size_t(0), plane, size_t(4096), [&](size_t p0) {
+    for (size_t p = p0; p < std::min(plane, p0 + 4096); ++p)
+      for (int f = 0; f < F; ++f) {
+        double v = 0.0;
+        for (int k = 0; k < m.n_acc; ++k) v += double(m.resolve[size_t(f) * m.n_acc + k]) * acc.pixels[k * plane + p];
+        out.pixels[f * plane + p] = exposure * float(v);
+      }
+  });
+  return out;
+}
+
+}  // namespace nebula::spectral

@@ -1,0 +1,39 @@
+#pragma once
+// Renders a voxel grid through any number of filters with the spectral
+// marcher (spectral/spectral_march.h): one function for the CPU (TBB) and
+// CUDA. The march writes each ray's accumulators; resolve_filters turns them
+// into one plane per filter (a filter change re-runs only the resolve).
+#include <vector>
+
+#include "core/backend.h"
+#include "core/camera.h"
+#include "core/grid.h"
+#include "core/image.h"
+#include "spectral/spectral_model.h"
+
+namespace nebula::spectral {
+
+struct SpectralLight {
+  Vec3 position;
+  double luminosity_lsun = 1;
+  const std::vector<float>* depth_v = nullptr;  // baked V-band depth per voxel (illumination/optical_depth_bake.h)
+};
+
+struct SpectralRenderInputs {
+  const DensityGrid* density = nullptr;
+  const SpectralModel* model = nullptr;  // built for these lights, in this order
+  std::vector<SpectralLight> lights;
+  float albedo = 0.6f, g = 0.6f;
+  Camera camera;
+};
+
+// The accumulator image (model->n_acc planes); `seconds` the march alone
+// (CUDA events on the GPU). Throws Error on inconsistent inputs.
+Image render_spectral(const SpectralRenderInputs& in, Backend backend, double* seconds = nullptr);
+Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds);
+Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds);
+
+// One plane per filter (the model's names), times the exposure.
+Image resolve_filters(const Image& accumulators, const SpectralModel& model, float exposure = 1.0f);
+
+}  // namespace nebula::spectral

@@ -1,0 +1,103 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "core/error.h"
+#include "illumination/filters.h"
+#include "spectral/spectral_test_scene.h"
+
+namespace nebula::spectral {
+namespace {
+
+std::vector<std::pair<std::string, Passband>> filters(std::initializer_list<const char*> names) {
+  std::vector<std::pair<std::string, Passband>> out;
+  for (const char* n : names) out.push_back({n, load_filter(n)});
+  return out;
+}
+
+Image render_with(const testing::SpectralTestScene& scene, const SpectralModel& m) {
+  return resolve_filters(render_spectral(scene.inputs(m), Backend::Cpu), m);
+}
+
+// Largest relative error per pixel over pixels above 1e-3 of the peak.
+double worst_relative(const Image& a, const Image& ref) {
+  double peak = 0, worst = 0;
+  for (float v : ref.pixels) peak = std::max(peak, double(v));
+  for (size_t i = 0; i < ref.pixels.size(); ++i)
+    if (ref.pixels[i] > 1e-3 * peak) worst = std::max(worst, double(std::fabs(a.pixels[i] - ref.pixels[i]) / ref.pixels[i]));
+  return worst;
+}
+
+// A thin dust cube (tau_V 1e-5 per voxel): the light is single scattering of
+// the unattenuated star, w * integral S kappa B (D ~ 0), the same for every
+// method; and the image is not empty.
+TEST(SpectralRenderer, ThinDustIsTheFilteredBlackBody) {
+  auto scene = testing::noise_scene(8, 1e-5f, {{0.9f, 0.2f, 0.1f}}, 24, 16);
+  SpectralSettings s;
+  s.wavelengths = 4000;
+  s.method = SpectralMethod::Double;
+  const SpectralModel ref_model = build_spectral_model(filters({"B", "V", "R"}), {{41400}}, s);
+  const Image ref = render_with(scene, ref_model);
+  double peak = 0;
+  for (float v : ref.pixels) peak = std::max(peak, double(v));
+  EXPECT_GT(peak, 0.0);
+  for (SpectralMethod m : {SpectralMethod::Analytic, SpectralMethod::Projection, SpectralMethod::LightBasis}) {
+    s.method = m;
+    const double err = worst_relative(render_with(scene, build_spectral_model(filters({"B", "V", "R"}), {{41400}}, s)), ref);
+    std::printf("  method %d: largest pixel error %.2e against the double integral (M = 4000)\n", int(m), err);
+    EXPECT_LT(err, m == SpectralMethod::LightBasis ? 2e-2 : 2e-3);
+  }
+}
+
+// Noise dust (tau_V up to 1 per voxel of 16, ~8 across the cube): the
+// projection's largest pixel error against the double integral, per basis
+// size. With the relative basis (ours) 4 elements meet the issue's 1% per
+// pixel; the report's absolute basis leaves dim pixels, lit through long
+// optical paths, wrong by 100% (docs/spectral.md, "Relative projection").
+TEST(SpectralRenderer, ProjectionErrorPerBasisSize) {
+  auto scene = testing::noise_scene(16, 1.0f, {{0.1f, 0.2f, -0.1f}}, 32, 24);
+  SpectralSettings s;
+  s.method = SpectralMethod::Double;
+  s.wavelengths = 1000;
+  const auto f = filters({"B", "V", "R", "sdss_g"});
+  const Image ref = render_with(scene, build_spectral_model(f, {{9700}}, s));
+  s.method = SpectralMethod::Projection;
+  double first = 0;
+  for (int n = 1; n <= 4; ++n) {
+    s.basis = n;
+    const double err = worst_relative(render_with(scene, build_spectral_model(f, {{9700}}, s)), ref);
+    std::printf("  projection, %d elements: largest pixel error %.2e\n", n, err);
+    if (n == 1) first = err;
+    if (n == 4) {
+      EXPECT_LT(err, 0.1 * first);
+      EXPECT_LT(err, 1e-2);
+    }
+  }
+  s.relative = false;
+  const double absolute = worst_relative(render_with(scene, build_spectral_model(f, {{9700}}, s)), ref);
+  std::printf("  absolute (the report's) basis, 4 elements: largest pixel error %.2e\n", absolute);
+  EXPECT_GT(absolute, 0.1);
+}
+
+// A filter change on a fixed basis range: the same accumulators resolved with
+// the new filters equal a fresh render with them.
+TEST(SpectralRenderer, FilterChangeNeedsNoNewMarch) {
+  auto scene = testing::noise_scene(12, 0.5f, {{0.1f, 0.2f, -0.1f}, {-0.3f, 0.0f, 0.2f}}, 20, 20);
+  SpectralSettings s;
+  s.method = SpectralMethod::LightBasis;
+  s.lo_um = 0.3;
+  s.hi_um = 1.0;
+  std::vector<SpectralStar> stars{{41400}, {3850}};
+  SpectralModel m = build_spectral_model(filters({"B", "V"}), stars, s);
+  const Image acc = render_spectral(scene.inputs(m), Backend::Cpu);
+  set_filters(m, filters({"sdss_r", "F606W"}));
+  const Image changed = resolve_filters(acc, m);
+  const Image fresh = render_with(scene, build_spectral_model(filters({"sdss_r", "F606W"}), stars, s));
+  ASSERT_EQ(changed.bands, fresh.bands);
+  for (size_t i = 0; i < fresh.pixels.size(); ++i) EXPECT_NEAR(changed.pixels[i], fresh.pixels[i], 1e-5f * (1 + fresh.pixels[i]));
+  EXPECT_THROW(set_filters(m, filters({"sdss_z"})), Error);  // reaches 1.11 um, past the basis range
+}
+
+}  // namespace
+}  // namespace nebula::spectral
