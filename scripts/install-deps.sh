@@ -8,7 +8,7 @@ packages=(
   libtbb-dev libhdf5-dev libcli11-dev libgtest-dev
   libtomlplusplus-dev libcfitsio-dev libopenimageio-dev
   python3-numpy python3-matplotlib python3-h5py python3-venv
-  python3-dev pybind11-dev
+  python3-dev pybind11-dev python3-pytest
   # issue 13: animate's MP4 (H.264), the viewer (GLFW, Dear ImGui, OpenGL) and its tests under Xvfb with Mesa
   ffmpeg libglfw3-dev libimgui-dev libgl-dev xvfb xauth libgl1-mesa-dri
 )
