@@ -394,6 +394,7 @@ void add_bench_command(CLI::App& app) {
   add_pyramid(cmd);
   add_truth(cmd);
   add_axial(cmd);
+  add_frame_benchmarks(cmd);  // app/bench_frames.cpp: animate, viewer
   add_sweep(cmd);
   add_spectral_bench(cmd);
 }

@@ -14,6 +14,8 @@ void add_spectral_bench(CLI::App* bench);
 void add_render_command(CLI::App& app);
 void add_truth_command(CLI::App& app);
 void add_compare_command(CLI::App& app);
+void add_animate_command(CLI::App& app);
+void add_frame_benchmarks(CLI::App* bench);  // `nebula bench animate`, `nebula bench viewer`
 void add_sweep_command(CLI::App& app);
 
 }  // namespace nebula::app

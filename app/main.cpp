@@ -62,6 +62,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "nebula 0.1.0");
   nebula::app::add_render_command(app);
   nebula::app::add_truth_command(app);
+  nebula::app::add_animate_command(app);
   nebula::app::add_compare_command(app);
   nebula::app::add_sweep_command(app);
   nebula::app::add_tabulate_command(app);

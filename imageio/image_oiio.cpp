@@ -141,10 +141,11 @@ void write_png(const Image& image, const ImageMetadata& metadata, const std::str
   OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::UINT8);
   spec.attribute("oiio:ColorSpace", "sRGB");
   spec.attribute(kPrefix + kBandsName, join_bands(image.bands));
-  spec.attribute("nebula:tone_map", "value x exposure, clamped to [0, 1], sRGB curve (IEC 61966-2-1)");
-  add_metadata(spec, metadata);
+  const DisplaySettings& display = metadata.display;
+  // The channels shown (weighted sums of the bands), then the display transform;
+  // auto exposure looks at the channels shown.
   const size_t plane = image.plane_size();
-  std::vector<uint8_t> levels(plane * channels);
+  std::vector<float> shown(plane * size_t(channels));
   for (size_t i = 0; i < plane; ++i)
     for (int c = 0; c < channels; ++c) {
       float v = 0.0f;
@@ -152,8 +153,18 @@ void write_png(const Image& image, const ImageMetadata& metadata, const std::str
         const PngColour& w = colours[b];
         v += (c == 0 ? w.red : c == 1 ? w.green : w.blue) * image.pixels[b * plane + i];
       }
-      levels[i * channels + c] = srgb_level(v, metadata.exposure);
+      shown[size_t(c) * plane + i] = v;
     }
+  const double exposure = display.auto_exposure ? auto_exposure_of(shown, display, metadata.exposure) : metadata.exposure;
+  spec.attribute("nebula:tone_map", std::string(to_string(display.stretch)) + " stretch of value x exposure " +
+                                        exact_text(exposure) + (display.auto_exposure ? " (auto)" : "") +
+                                        " / white " + exact_text(display.white) + ", softening " +
+                                        exact_text(display.softening) + ", clamped to [0, 1], sRGB curve (IEC 61966-2-1)");
+  add_metadata(spec, metadata);
+  std::vector<uint8_t> levels(plane * channels);
+  for (size_t i = 0; i < plane; ++i)
+    for (int c = 0; c < channels; ++c)
+      levels[i * channels + c] = display_level(shown[size_t(c) * plane + i], exposure, display);
   write_with("png", spec, OIIO::TypeDesc::UINT8, levels.data(), file_name);
 }
 

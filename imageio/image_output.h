@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/display.h"
 #include "core/image.h"
 
 namespace nebula {
@@ -57,6 +58,9 @@ struct ImageMetadata {
   // and leave the pixels alone: a display setting, not part of the data.
   double exposure = 1.0;
   double gamma = 2.2;     // unused by the writers: PNG uses the sRGB curve (README)
+  // PNG only: stretch, white point, auto exposure (core/display.h). Science
+  // formats neither apply nor record it.
+  DisplaySettings display;
   // The resolved scene (TOML text) the image was made from, or empty. Any
   // bytes but NUL; FITS keeps it in an extension SCENE, HDF5 in the
   // attribute scene_toml, EXR in nebula:scene.

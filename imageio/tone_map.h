@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "core/display.h"
+
 namespace nebula {
 
 // IEC 61966-2-1 encoding of a linear value in [0, 1]: a straight line near
@@ -20,6 +22,13 @@ inline uint8_t srgb_level(float value, double exposure) {
   const double x = double(value) * exposure;
   const double scaled = x > 0.0 ? std::min(x, 1.0) : 0.0;
   return static_cast<uint8_t>(std::lround(255.0 * srgb_encode(scaled)));
+}
+
+// The 8-bit level of a pixel under a display transform (core/display.h):
+// stretch_value of value x exposure, then the sRGB curve. The default
+// (linear, white 1) is srgb_level exactly.
+inline uint8_t display_level(float value, double exposure, const DisplaySettings& display) {
+  return static_cast<uint8_t>(std::lround(255.0 * srgb_encode(stretch_value(double(value) * exposure, display))));
 }
 
 }  // namespace nebula

@@ -104,6 +104,7 @@ ImageMetadata scene_metadata(const Scene& scene, const SceneBands& bands, const 
   // The pixels are radiance; the exposure is a display setting, applied
   // only when the image is tone-mapped (PNG).
   meta.exposure = camera.exposure;
+  meta.display = scene.display;  // PNG only
   meta.entries = camera_wcs(camera);
   meta.entries.push_back({"DATE", utc_now()});
   meta.entries.push_back({"software", std::string("nebula ") + NEBULA_VERSION});

@@ -102,6 +102,19 @@ struct ProceduralParams {
   int noise_octaves = 5;
   double noise_gain = 0.5;        // amplitude ratio of successive octaves
   double noise_lacunarity = 2.0;  // frequency ratio of successive octaves
+
+  // Issue 13's structure (each off by default, so older scenes keep their dust):
+  // the far side's boundary moved behind the star and warped by the noise, so a
+  // side view shows no straight cut through the star; and filaments, ridged
+  // noise: density *= exp(filament_amplitude * (ridge - 1/2)), ridge in [0, 1]
+  // high on thin sheets where independent noise crosses zero.
+  double far_offset = 0.0;         // the boundary lies this far beyond the star (fraction of the edge)
+  double far_warp = 0.0;           // and moves by far_warp x the fractal noise
+  double filament_amplitude = 0.0;
+  double filament_frequency = 4.0;  // cycles per cube edge of the first ridged octave
+  int filament_octaves = 3;         // each twice the frequency and half the weight of the one before
+  double filament_sharpness = 6.0;  // ridge = (1 - |noise|)^sharpness: higher, thinner filaments
+  double edge_fade = 0.0;  // density falls smoothly to 0 over this fraction of the edge at the cube's faces
 };
 
 // The first parameter outside its range (docs/scene.md), or nothing.

@@ -166,6 +166,14 @@ std::optional<ParameterIssue> check_procedural(const ProceduralParams& p) {
     c.refuse("noise_octaves", std::to_string(p.noise_octaves), "must be in [0, 16]");
   c.range("noise_gain", p.noise_gain, 0, 1, true, false);
   c.range("noise_lacunarity", p.noise_lacunarity, 1, 16, true, false);
+  c.range("far_offset", p.far_offset, -2, 2, false, false);
+  c.range("far_warp", p.far_warp, 0, 2, false, false);
+  c.range("filament_amplitude", p.filament_amplitude, 0, 20, false, false);
+  c.range("filament_frequency", p.filament_frequency, 0, 4096, true, false);
+  if (p.filament_octaves < 1 || p.filament_octaves > 8)
+    c.refuse("filament_octaves", std::to_string(p.filament_octaves), "must be in [1, 8]");
+  c.range("filament_sharpness", p.filament_sharpness, 0, 64, true, false);
+  c.range("edge_fade", p.edge_fade, 0, 0.5, false, false);
   if (!c.issue && p.noise_octaves > 0) {
     const double top = p.noise_frequency * std::pow(p.noise_lacunarity, p.noise_octaves - 1);
     if (!(top <= kMaxNoiseFrequency))
@@ -206,8 +214,20 @@ DensityGrid procedural_nebula(const ProceduralParams& p) {
 
   const NoisePlan plan = plan_noise(p);
   std::vector<LatticeCache> lattices;
-  if (p.noise_amplitude > 0)
+  if (p.noise_amplitude > 0 || p.far_warp > 0)
     for (const Octave& o : plan.octaves) lattices.push_back(cache_octave(p.seed, o));
+  // Filaments: lattices of their own (octave indices from 64 on), up to n / 2 cycles per edge.
+  std::vector<Octave> ridge_octaves;
+  std::vector<LatticeCache> ridges;
+  double ridge_total = 0;
+  if (p.filament_amplitude > 0) {
+    double f = p.filament_frequency, w = 1;
+    for (int o = 0; o < p.filament_octaves; ++o, f *= 2, w *= 0.5) {
+      ridge_total += w;
+      if (f <= 0.5 * p.n) ridge_octaves.push_back({f, w, uint32_t(64 + o)});
+    }
+    for (const Octave& o : ridge_octaves) ridges.push_back(cache_octave(p.seed, o));
+  }
 
   const Vec3d wind = unit(p.wind_direction), near = unit(p.near_side);
   const double sx = p.star.x, sy = p.star.y, sz = p.star.z;
@@ -229,8 +249,18 @@ DensityGrid procedural_nebula(const ProceduralParams& p) {
                                   : p.cloud_tau * std::exp(-(d - p.bubble_radius) / p.scale_length);
           const double s = d - shell_centre;
           const double shell = p.shell_tau * std::exp(-shell_k * s * s);
-          // Height towards the camera side, measured from the star's plane.
-          const double h = (u - sx) * near.x + (v - sy) * near.y + (w - sz) * near.z;
+          double noise = 0;  // the fractal noise in [-1, 1]
+          if (!lattices.empty()) {
+            double sum = 0;
+            for (size_t o = 0; o < lattices.size(); ++o)
+              sum += plan.octaves[o].weight *
+                     value_noise(plan.octaves[o].frequency, u, v, w, lattices[o]);
+            noise = sum / plan.normalisation;
+          }
+          // Height towards the camera side, measured from the far side's boundary
+          // (the star's plane unless moved back and warped).
+          const double h = (u - sx) * near.x + (v - sy) * near.y + (w - sz) * near.z + p.far_offset +
+                           p.far_warp * noise;
           double far = 1;
           if (p.far_transition > 0) {
             const double t = std::fmin(std::fmax(-h / p.far_transition, 0.0), 1.0);
@@ -238,16 +268,23 @@ DensityGrid procedural_nebula(const ProceduralParams& p) {
           } else if (h < 0) {
             far = p.far_multiplier;
           }
-          double contrast = 1;
-          if (!lattices.empty()) {
-            double sum = 0;
-            for (size_t o = 0; o < lattices.size(); ++o)
-              sum += plan.octaves[o].weight *
-                     value_noise(plan.octaves[o].frequency, u, v, w, lattices[o]);
-            contrast = std::exp(p.noise_amplitude * (sum / plan.normalisation));
+          double contrast = p.noise_amplitude > 0 ? std::exp(p.noise_amplitude * noise) : 1.0;
+          if (!ridges.empty()) {
+            double ridge = 0;
+            for (size_t o = 0; o < ridges.size(); ++o)
+              ridge += ridge_octaves[o].weight *
+                       std::pow(1.0 - std::fabs(value_noise(ridge_octaves[o].frequency, u, v, w, ridges[o])),
+                                p.filament_sharpness);
+            contrast *= std::exp(p.filament_amplitude * (ridge / ridge_total - 0.5));
           }
+          double fade_out = 1;  // no hard cube faces: smoothstep to 0 at each face
+          if (p.edge_fade > 0)
+            for (double c : {u, v, w}) {
+              const double t = std::fmin(std::fmin(c, 1.0 - c) / p.edge_fade, 1.0);
+              fade_out *= t * t * (3 - 2 * t);
+            }
           grid.tau_v[grid.shape.index(x, y, z)] =
-              static_cast<float>((base + shell) * far * contrast * per_voxel);
+              static_cast<float>((base + shell) * far * contrast * fade_out * per_voxel);
         }
   });
   check_grid_values("procedural density", grid.shape, grid.tau_v);

@@ -13,9 +13,11 @@
 #include <vector>
 
 #include "core/camera.h"
+#include "core/display.h"
 #include "core/grid.h"
 #include "core/vec3.h"
 #include "illumination/extinction.h"
+#include "scene/camera_path.h"
 #include "illumination/passband.h"
 
 namespace nebula {
@@ -138,6 +140,8 @@ struct Scene {
   DustParams dust;
   std::vector<SceneStar> stars;
   CameraSettings camera = scene_camera_defaults();
+  std::optional<CameraPath> camera_path;  // [animation]: keyframes for `nebula animate`
+  DisplaySettings display;                // [display]: how PNGs and the viewer show radiance
   std::string output = "nebula.exr";  // as written; relative to the working directory
   bool draw_stars = false;
   double star_psf_pixels = 1.5;  // Gaussian sigma of a drawn star, pixels

@@ -20,6 +20,8 @@
 #include "core/error.h"
 #include "illumination/filter_file.h"
 #include "illumination/star.h"
+#include "scene/camera_path_toml.h"
+#include "scene/display_toml.h"
 #include "scene/scene_checks.h"
 
 namespace nebula {
@@ -61,7 +63,7 @@ const char* type_name(const toml::node& n) {
 // The keys of every table in a scene file.
 const std::initializer_list<std::string_view> kTopKeys = {"bands",  "density", "emission", "dust",   "stars",
                                                           "camera", "output",  "render",   "axial",  "filters",
-                                                          "spectral"};
+                                                          "spectral", "animation", "display"};
 const std::initializer_list<std::string_view> kSpectralKeys = {
     "method", "basis", "wavelengths", "attenuation", "norm", "fit_depth", "max_depth", "range_um"};
 const std::initializer_list<std::string_view> kRenderKeys = {
@@ -77,7 +79,8 @@ const std::initializer_list<std::string_view> kProceduralKeys = {
     "wind_direction", "bubble_offset",  "bubble_radius",   "bubble_tau",     "shell_thickness",
     "shell_tau",     "cloud_tau",       "scale_length",    "near_side",      "far_multiplier",
     "far_transition", "noise_amplitude", "noise_frequency", "noise_octaves", "noise_gain",
-    "noise_lacunarity"};
+    "noise_lacunarity", "far_offset", "far_warp", "filament_amplitude", "filament_frequency",
+    "filament_octaves", "filament_sharpness", "edge_fade"};
 const std::initializer_list<std::string_view> kEmissionKeys = {"file", "prefix"};
 const std::initializer_list<std::string_view> kDustKeys = {"albedo", "g", "R_V", "law", "tables"};
 const std::initializer_list<std::string_view> kStarKeys = {"name", "position", "luminosity_lsun",
@@ -451,6 +454,13 @@ ProceduralParams Parser::parse_procedural(const toml::table& t, const std::strin
   small("noise_octaves", p.noise_octaves);
   num("noise_gain", p.noise_gain);
   num("noise_lacunarity", p.noise_lacunarity);
+  num("far_offset", p.far_offset);
+  num("far_warp", p.far_warp);
+  num("filament_amplitude", p.filament_amplitude);
+  num("filament_frequency", p.filament_frequency);
+  small("filament_octaves", p.filament_octaves);
+  num("filament_sharpness", p.filament_sharpness);
+  num("edge_fade", p.edge_fade);
   if (const auto issue = check_procedural(p)) fail(join(key, issue->parameter), issue->reason);
   return p;
 }
@@ -830,6 +840,11 @@ Scene Parser::build(toml::table& root, const Scene* reuse_grids) {
     }
   }
   scene.camera = parse_camera(root);
+  if (const toml::node* a = root.get("animation"))
+    scene.camera_path = scene_detail::parse_camera_path(
+        *a, scene.camera, [this](const std::string& key, const std::string& reason) { fail(key, reason); });
+  if (const toml::node* d = root.get("display"))
+    scene.display = scene_detail::parse_display(*d, [this](const std::string& key, const std::string& reason) { fail(key, reason); });
   parse_output(root, scene);
   parse_render(root, scene);
   if (const auto issue = scene_detail::settings_issue(scene)) fail(issue->key, issue->reason);
@@ -905,7 +920,35 @@ Scene load_scene(const std::string& path, const std::vector<std::string>& overri
   return scene;
 }
 
-ProceduralParams demo_procedural_params() { return ProceduralParams{}; }
+// The recipe's parts (bubble, shell, fall-off, far side, noise) tuned to show
+// structure (issue 13): an off-centre star, finer and stronger noise, filaments,
+// the far side's boundary behind the star and warped, faded cube faces.
+ProceduralParams demo_procedural_params() {
+  ProceduralParams p;
+  p.star = Vec3{0.40f, 0.52f, 0.55f};
+  p.wind_direction = Vec3{0.3f, -1.0f, 0.4f};
+  p.bubble_offset = 0.05;
+  p.bubble_radius = 0.15;
+  p.bubble_tau = 0.3;
+  p.shell_thickness = 0.05;
+  p.shell_tau = 14.0;
+  p.cloud_tau = 8.0;
+  p.scale_length = 0.18;
+  p.far_multiplier = 5.0;
+  p.far_transition = 0.08;
+  p.far_offset = 0.12;
+  p.far_warp = 0.15;
+  p.noise_amplitude = 3.2;
+  p.noise_frequency = 5.0;
+  p.noise_octaves = 6;
+  p.noise_gain = 0.65;
+  p.filament_amplitude = 5.0;
+  p.filament_frequency = 3.0;
+  p.filament_octaves = 3;
+  p.filament_sharpness = 10.0;
+  p.edge_fade = 0.45;
+  return p;
+}
 
 Scene demo_scene() {
   Scene scene;
@@ -925,12 +968,30 @@ Scene demo_scene() {
   star.temperature_K = effective_temperature_K("O5V");
   scene.stars.push_back(star);
   scene.camera.projection = Projection::Perspective;
-  scene.camera.position = Vec3{1.0f, -2.5f, 1.3f};
-  scene.camera.look_at = star.position;
+  scene.camera.position = Vec3{2.9f, -1.9f, 1.5f};
+  scene.camera.look_at = Vec3{1.1f, 1.0f, 1.05f};  // beside the star: it sits left of centre
   scene.camera.up = Vec3{0, 0, 1};
-  scene.camera.fov_deg = 40;
+  scene.camera.fov_deg = 50;
   scene.camera.width = scene.camera.height = 512;
-  scene.camera.exposure = 0.02;  // maps the 99th percentile of B to about 0.8 in a PNG
+  scene.camera.exposure = 0.02;  // recorded; the PNG's auto exposure picks its own
+  scene.display.stretch = Stretch::Asinh;
+  scene.display.auto_exposure = true;
+  scene.display.percentile = 99.9;
+  scene.display.softening = 0.01;
+  // A fly-around that ends close to the star (`nebula animate --demo`).
+  CameraPath path;
+  const Vec3 stops[] = {{2.9f, -1.9f, 1.5f}, {-0.9f, -2.4f, 1.3f}, {-1.6f, 0.6f, 1.9f}, {0.2f, -0.6f, 1.2f}};
+  const double times[] = {0, 4, 8, 10};
+  for (int i = 0; i < 4; ++i) {
+    CameraKeyframe k;
+    k.time = times[i];
+    k.position = stops[i];
+    k.look_at = scene.camera.look_at;
+    k.up = scene.camera.up;
+    k.fov_deg = scene.camera.fov_deg;
+    path.keys.push_back(k);
+  }
+  scene.camera_path = path;
   scene.output = "demo.exr";
   scene.draw_stars = false;
   scene.star_psf_pixels = 1.5;

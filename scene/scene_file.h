@@ -30,10 +30,12 @@ Scene load_scene_text(const std::string& text, const std::string& name,
                       const std::string& base_dir, const std::vector<std::string>& overrides = {},
                       const Scene* reuse_grids = nullptr);
 
-// The built-in demo (`nebula render --demo`), equal to scenes/demo.toml: the
-// default procedural nebula (128^3 voxels, 2 pc), one O5V star of 2e5 L_sun
-// at the procedural star, a 512 x 512 perspective camera 3.5 pc away on the
-// near side (-y) looking at the star, dust a = g = 0.6, R_V = 5 (CCM89).
+// The built-in demo (`nebula render --demo`), equal to scenes/demo.toml: a
+// procedural nebula tuned to show structure (128^3 voxels, 2 pc; the star
+// off-centre, filaments, docs/scene.md), one O5V star of 2e5 L_sun at the
+// procedural star, a 512 x 512 perspective camera on the near side (-y)
+// looking past the star, dust a = g = 0.6, R_V = 5 (CCM89), an asinh display
+// with auto exposure, and a camera path for `nebula animate --demo`.
 ProceduralParams demo_procedural_params();
 Scene demo_scene();
 

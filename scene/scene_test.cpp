@@ -442,6 +442,22 @@ void expect_same_scene(const Scene& a, const Scene& b) {
   EXPECT_EQ(c.width, d.width);
   EXPECT_EQ(c.height, d.height);
   EXPECT_EQ(c.exposure, d.exposure);
+  EXPECT_TRUE(a.display == b.display);
+  ASSERT_EQ(a.camera_path.has_value(), b.camera_path.has_value());
+  if (a.camera_path) {
+    EXPECT_EQ(a.camera_path->timing, b.camera_path->timing);
+    ASSERT_EQ(a.camera_path->keys.size(), b.camera_path->keys.size());
+    for (size_t i = 0; i < a.camera_path->keys.size(); ++i) {
+      const CameraKeyframe &k = a.camera_path->keys[i], &l = b.camera_path->keys[i];
+      EXPECT_EQ(k.time, l.time);
+      EXPECT_EQ(k.fov_deg, l.fov_deg);
+      for (auto [p, q] : {std::pair{k.position, l.position}, {k.look_at, l.look_at}, {k.up, l.up}}) {
+        EXPECT_EQ(p.x, q.x);
+        EXPECT_EQ(p.y, q.y);
+        EXPECT_EQ(p.z, q.z);
+      }
+    }
+  }
   EXPECT_EQ(a.output, b.output);
   EXPECT_EQ(a.draw_stars, b.draw_stars);
   EXPECT_EQ(a.star_psf_pixels, b.star_psf_pixels);

@@ -9,6 +9,8 @@ packages=(
   libtomlplusplus-dev libcfitsio-dev libopenimageio-dev
   python3-numpy python3-matplotlib python3-h5py python3-venv
   python3-dev pybind11-dev python3-pytest
+  # issue 13: animate's MP4 (H.264), the viewer (GLFW, Dear ImGui, OpenGL) and its tests under Xvfb with Mesa
+  ffmpeg libglfw3-dev libimgui-dev libgl-dev xvfb xauth libgl1-mesa-dri
 )
 
 missing=()

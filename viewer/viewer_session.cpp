@@ -1,0 +1,393 @@
+#include "viewer/viewer_session.h"
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+#include "scene/scene_file.h"
+#include "viewer/demo_scene_text.h"
+
+namespace nebula::viewer {
+namespace {
+
+// Passes of the ground truth accumulated for one view at most (256 samples per pixel).
+constexpr int kTruthPasses = 128;
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+// ------------------------------------------------------------ SceneSource
+
+SceneSource SceneSource::from_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    const int err = errno;
+    throw Error(path + ": cannot read the scene file (" + std::strerror(err ? err : ENOENT) + ")");
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  std::string dir = path.find('/') == std::string::npos ? "." : path.substr(0, path.find_last_of('/'));
+  if (dir.empty()) dir = "/";
+  return SceneSource(text.str(), path, dir);
+}
+
+SceneSource SceneSource::demo() { return SceneSource(kDemoSceneText, "demo", "."); }
+
+void SceneSource::set(const std::string& key, const std::string& value) {
+  unset(key);
+  overrides_.emplace_back(key, value);
+}
+
+void SceneSource::unset(const std::string& key) {
+  for (auto it = overrides_.begin(); it != overrides_.end();)
+    it = it->first == key ? overrides_.erase(it) : it + 1;
+}
+
+std::vector<std::string> SceneSource::overrides() const {
+  std::vector<std::string> out;
+  for (const auto& [key, value] : overrides_) out.push_back(key + "=" + value);
+  return out;
+}
+
+Scene SceneSource::load() const { return load_scene_text(text_, name_, base_dir_, overrides()); }
+
+Scene SceneSource::load_reusing(const Scene& previous) const {
+  return load_scene_text(text_, name_, base_dir_, overrides(), &previous);
+}
+
+std::string toml_number(double v) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%.17g", v);
+  std::string s = text;
+  // TOML floats need a dot or an exponent; integers are fine as they are.
+  return s;
+}
+
+std::string toml_vec3(Vec3 v) {
+  char text[120];
+  std::snprintf(text, sizeof text, "[%.9g, %.9g, %.9g]", double(v.x), double(v.y), double(v.z));
+  return text;
+}
+
+void set_view_overrides(SceneSource& s, const CameraSettings& c, const DisplaySettings& d,
+                        const std::vector<CameraKeyframe>& keys) {
+  s.set("camera.kind", std::string("\"") + to_string(c.projection) + "\"");
+  s.set("camera.position", toml_vec3(c.position));
+  s.set("camera.look_at", toml_vec3(c.look_at));
+  s.set("camera.up", toml_vec3(c.up));
+  s.set("camera.fov_deg", toml_number(c.fov_deg));
+  if (c.projection == Projection::Orthographic) s.set("camera.ortho_width", toml_number(c.ortho_width));
+  s.set("camera.width", std::to_string(c.width));
+  s.set("camera.height", std::to_string(c.height));
+  s.set("camera.exposure", toml_number(c.exposure));
+  s.set("display.stretch", std::string("\"") + to_string(d.stretch) + "\"");
+  s.set("display.auto_exposure", d.auto_exposure ? "true" : "false");
+  s.set("display.percentile", toml_number(d.percentile));
+  s.set("display.white", toml_number(d.white));
+  s.set("display.softening", toml_number(d.softening));
+  if (keys.size() >= 2) {
+    std::string array;
+    for (const CameraKeyframe& k : keys)
+      array += std::string(array.empty() ? "" : ", ") + "{time = " + toml_number(k.time) + ", position = " +
+               toml_vec3(k.position) + ", look_at = " + toml_vec3(k.look_at) + ", up = " + toml_vec3(k.up) +
+               ", fov_deg = " + toml_number(k.fov_deg) + "}";
+    s.set("animation", "{keyframes = [" + array + "]}");
+  }
+}
+
+// ------------------------------------------------------------ Session
+
+struct Session::Baked {
+  std::shared_ptr<const Scene> scene;
+  RenderOptions options;
+  PreparedGrid prepared;  // built in place: it points into itself and into *scene
+  Baked(std::shared_ptr<const Scene> s, const RenderOptions& o)
+      : scene(std::move(s)), options(o), prepared(per_frame() ? PreparedGrid{} : prepare_grid(*scene, o)) {}
+
+  // An axial map bakes with its render (cheap beside a 3D grid's bake); the
+  // spectral renderer has no bake to keep.
+  bool per_frame() const { return scene->axial.has_value() || scene->spectral.has_value(); }
+
+  RenderOutput render(const CameraSettings& camera) const {
+    if (!per_frame()) return render_prepared(prepared, camera);
+    Scene copy = *scene;
+    copy.camera = camera;
+    return render_scene(copy, options);
+  }
+};
+
+Session::Session(SceneSource source, const ViewerOptions& options)
+    : options_(options), source_(std::move(source)) {
+  shown_scene_ = std::make_shared<const Scene>(source_.load());
+  latest_scene_ = shown_scene_;
+  status_.activity = "baking (" + why_ + ")";
+  status_.busy = true;
+  thread_ = std::thread([this] { work(); });
+}
+
+Session::~Session() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void Session::edit(const std::string& key, const std::string& value) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    source_.set(key, value);
+    ++wanted_version_;
+    why_ = key + " changed";
+  }
+  wake_.notify_all();
+}
+
+void Session::request(const CameraSettings& camera) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    wanted_camera_ = camera;
+    ++wanted_request_;
+  }
+  wake_.notify_all();
+}
+
+std::optional<Frame> Session::take_frame() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::optional<Frame> out = std::move(frame_);
+  frame_.reset();
+  return out;
+}
+
+void Session::set_truth(bool on) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    truth_on_ = on;
+    if (!on) truth_.reset();
+  }
+  wake_.notify_all();
+}
+
+std::optional<TruthFrame> Session::truth() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return truth_;
+}
+
+SessionStatus Session::status() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return status_;
+}
+
+bool Session::idle() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return !working_ && wanted_version_ == baked_version_ &&
+         (!wanted_camera_ || !baked_ || wanted_request_ == rendered_request_);
+}
+
+void Session::wait_idle() const {
+  std::unique_lock<std::mutex> lock(mutex_);
+  done_.wait(lock, [&] {
+    return !working_ && wanted_version_ == baked_version_ &&
+           (!wanted_camera_ || !baked_ || wanted_request_ == rendered_request_);
+  });
+}
+
+SceneSource Session::source() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return source_;
+}
+
+std::shared_ptr<const PreparedGrid> Session::prepared() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!baked_ || baked_->per_frame() || baked_->scene->pyramid_levels > 0 ||
+      baked_->scene->multiple_scattering == MultipleScattering::Pyramid)
+    return nullptr;
+  return std::shared_ptr<const PreparedGrid>(baked_, &baked_->prepared);
+}
+
+void Session::sync_scene() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  shown_scene_ = latest_scene_;
+}
+
+std::string Session::saved_scene_text(const CameraSettings& camera, const DisplaySettings& display,
+                                      const std::vector<CameraKeyframe>& keys) const {
+  SceneSource s = source();
+  set_view_overrides(s, camera, display, keys);
+  std::shared_ptr<const Scene> shown;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    shown = latest_scene_;
+  }
+  const Scene scene = s.load_reusing(*shown);
+  return "# Saved by nebula-view from " + s.name() + " and its edits; `nebula render` reproduces the view.\n" +
+         scene.resolved_toml + "\n";
+}
+
+void Session::work() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  SceneSource good = source_;  // the overrides of the last scene that loaded and baked
+  while (true) {
+    wake_.wait(lock, [&] {
+      return stop_ || wanted_version_ != baked_version_ ||
+             (wanted_camera_ && baked_ && wanted_request_ != rendered_request_) ||
+             (truth_on_ && baked_ && truth_camera_ && (!truth_ || truth_->passes < kTruthPasses));
+    });
+    if (stop_) return;
+    working_ = true;
+    const bool other_work = wanted_version_ != baked_version_ || (wanted_camera_ && baked_ && wanted_request_ != rendered_request_);
+    if (!other_work) {
+      // A pass of the ground truth for the last view: only when nothing else waits.
+      const CameraSettings camera = *truth_camera_;
+      const std::shared_ptr<const Baked> current = baked_;
+      const uint64_t version = baked_version_;
+      std::optional<TruthFrame> sum = truth_;
+      if (sum && (sum->version != version || !(sum->camera.width == camera.width && sum->camera.height == camera.height &&
+                                               sum->camera.position.x == camera.position.x &&
+                                               sum->camera.position.y == camera.position.y &&
+                                               sum->camera.position.z == camera.position.z &&
+                                               sum->camera.look_at.x == camera.look_at.x &&
+                                               sum->camera.look_at.y == camera.look_at.y &&
+                                               sum->camera.look_at.z == camera.look_at.z &&
+                                               sum->camera.fov_deg == camera.fov_deg &&
+                                               sum->camera.projection == camera.projection)))
+        sum.reset();
+      const int pass = sum ? sum->passes : 0;
+      status_.activity = "ground truth: pass " + std::to_string(pass + 1);
+      status_.busy = true;
+      lock.unlock();
+      std::string error;
+      try {
+        Scene scene = *current->scene;
+        scene.camera = camera;
+        TruthOptions t;
+        t.backend = options_.backend;
+        t.spp = 2;
+        t.seed = uint64_t(pass) + 1;  // independent passes
+        const TruthRenderOutput out = truth_scene(scene, t);
+        if (!sum) {
+          sum = TruthFrame{};
+          sum->mean = out.image;
+          sum->variance = out.variance;
+          for (float& v : sum->mean.pixels) v = 0;
+          for (float& v : sum->variance.pixels) v = 0;
+          sum->camera = camera;
+          sum->version = version;
+        }
+        // Running mean of equal passes; the variance of the mean of K passes is sum(var_k) / K^2.
+        const int k = pass + 1;
+        for (size_t i = 0; i < sum->mean.pixels.size(); ++i) {
+          sum->mean.pixels[i] += (out.image.pixels[i] - sum->mean.pixels[i]) / float(k);
+          const double var_sum = double(sum->variance.pixels[i]) * (k - 1) * (k - 1) + out.variance.pixels[i];
+          sum->variance.pixels[i] = float(var_sum / (double(k) * k));
+        }
+        sum->passes = k;
+        sum->spp = 2 * k;
+        double total = 0, var = 0;
+        for (size_t i = 0; i < sum->mean.pixels.size(); ++i) {
+          total += sum->mean.pixels[i];
+          var += sum->variance.pixels[i];
+        }
+        sum->noise = total > 0 ? std::sqrt(var) / total : 0;
+      } catch (const std::exception& e) {
+        error = e.what();
+      }
+      lock.lock();
+      if (!error.empty()) {
+        status_.error = "ground truth: " + error;
+        truth_on_ = false;
+      } else if (truth_on_ && version == baked_version_) {
+        truth_ = std::move(sum);
+      }
+    } else if (wanted_version_ != baked_version_) {
+      const uint64_t version = wanted_version_;
+      const SceneSource source = source_;
+      const std::shared_ptr<const Scene> previous = latest_scene_;
+      status_.activity = "baking (" + why_ + ")";
+      status_.busy = true;
+      lock.unlock();
+      std::shared_ptr<Baked> fresh;
+      std::string error;
+      const auto t0 = std::chrono::steady_clock::now();
+      try {
+        std::shared_ptr<const Scene> scene =
+            version == 1 ? previous : std::make_shared<const Scene>(source.load_reusing(*previous));
+        RenderOptions o;
+        o.backend = options_.backend;
+        o.table_photons = options_.table_photons;
+        o.smooth_step = options_.smooth_step;
+        fresh = std::make_shared<Baked>(scene, o);
+      } catch (const std::exception& e) {
+        error = e.what();
+      }
+      const double seconds = seconds_since(t0);
+      lock.lock();
+      if (fresh) {
+        baked_ = std::move(fresh);
+        latest_scene_ = baked_->scene;
+        good = source;
+        status_.error.clear();
+        status_.bake_seconds = seconds;
+        status_.report = baked_->prepared.report;
+        status_.version = version;
+        rendered_request_ = 0;  // the current view again, from the new bake
+      } else {
+        // The edit is undone: the scene stays the last one that worked.
+        status_.error = error + " (edit undone)";
+        if (version == wanted_version_) source_ = good;
+      }
+      baked_version_ = version;
+    } else {
+      const CameraSettings camera = *wanted_camera_;
+      const uint64_t request = wanted_request_;
+      const uint64_t version = baked_version_;
+      const std::shared_ptr<const Baked> current = baked_;
+      status_.activity = "rendering " + std::to_string(camera.width) + "x" + std::to_string(camera.height);
+      status_.busy = true;
+      lock.unlock();
+      Frame frame;
+      std::string error;
+      const auto t0 = std::chrono::steady_clock::now();
+      try {
+        RenderOutput out = current->render(camera);
+        frame.image = std::move(out.image);
+        frame.metadata = std::move(out.metadata);
+        frame.camera = camera;
+        frame.request = request;
+        frame.version = version;
+      } catch (const std::exception& e) {
+        error = e.what();
+      }
+      frame.seconds = seconds_since(t0);
+      lock.lock();
+      if (error.empty()) {
+        status_.frame_seconds = frame.seconds;
+        truth_camera_ = camera;
+        truth_.reset();  // a new view or a new bake: the truth starts again
+        frame_ = std::move(frame);
+      } else {
+        status_.error = error;
+      }
+      rendered_request_ = request;
+    }
+    working_ = false;
+    const bool more = wanted_version_ != baked_version_ || (wanted_camera_ && baked_ && wanted_request_ != rendered_request_) ||
+                      (truth_on_ && truth_ && truth_->passes < kTruthPasses);
+    if (!more) {
+      status_.activity = "idle";
+      status_.busy = false;
+    }
+    done_.notify_all();
+  }
+}
+
+}  // namespace nebula::viewer

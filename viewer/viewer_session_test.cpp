@@ -1,0 +1,201 @@
+// The viewer without a window: the background bake and render, edits that
+// change the picture as they should, a bad edit undone, and the saved scene
+// rendering the viewer's frame again bit for bit.
+#include "viewer/viewer_session.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <thread>
+
+#include "core/test_support.h"
+#include "imageio/image_output.h"
+#include "scene/scene_file.h"
+#include "viewer/display_image.h"
+
+namespace nebula::viewer {
+namespace {
+
+const char* kScene = R"(
+[density]
+procedural = { n = 16, size_pc = 2.0 }
+[[stars]]
+luminosity_lsun = 2e5
+class = "O5V"
+[camera]
+position = [1.0, -2.5, 1.0]
+look_at = [1.0, 1.0, 1.0]
+width = 24
+height = 20
+exposure = 0.02
+[render]
+diffuse_photons = 8192
+)";
+
+class ViewerSession : public ::testing::Test, protected nebula::testing::ScratchDir {
+ protected:
+  ViewerSession() : ScratchDir("nebula_viewer") {}
+  void SetUp() override { setenv("NEBULA_CACHE_DIR", path("cache").c_str(), 1); }
+  ViewerOptions options() const {
+    ViewerOptions o;
+    o.table_photons = 1000;
+    return o;
+  }
+  static Frame frame_of(Session& s, const CameraSettings& camera) {
+    s.request(camera);
+    s.wait_idle();
+    std::optional<Frame> f = s.take_frame();
+    EXPECT_TRUE(f.has_value());
+    return f ? *f : Frame{};
+  }
+};
+
+double total(const Image& image) { return std::accumulate(image.pixels.begin(), image.pixels.end(), 0.0); }
+
+TEST_F(ViewerSession, HigherAlbedoBrightensTheDust) {
+  Session s(SceneSource(kScene, "v.toml", "."), options());
+  const CameraSettings camera = s.scene().camera;
+  const Frame before = frame_of(s, camera);
+  ASSERT_GT(total(before.image), 0);
+  s.edit("dust.albedo", "0.9");
+  s.wait_idle();
+  EXPECT_TRUE(s.status().error.empty()) << s.status().error;
+  const Frame after = frame_of(s, camera);
+  EXPECT_GT(after.version, before.version);
+  EXPECT_GT(total(after.image), 1.2 * total(before.image));  // 0.9 / 0.6 more light scattered, less extinction aside
+  s.sync_scene();
+  EXPECT_EQ(s.scene().dust.albedo[0], 0.9);
+}
+
+TEST_F(ViewerSession, ABadEditIsUndoneAndSaysWhy) {
+  Session s(SceneSource(kScene, "v.toml", "."), options());
+  const CameraSettings camera = s.scene().camera;
+  const Frame before = frame_of(s, camera);
+  s.edit("dust.albedo", "3");
+  s.wait_idle();
+  const std::string error = s.status().error;
+  EXPECT_NE(error.find("dust.albedo"), std::string::npos) << error;
+  EXPECT_NE(error.find("undone"), std::string::npos) << error;
+  EXPECT_TRUE(s.source().overrides().empty());
+  const Frame again = frame_of(s, camera);
+  EXPECT_EQ(again.image.pixels, before.image.pixels);
+}
+
+TEST_F(ViewerSession, TheSavedSceneRendersTheSameImage) {
+  Session s(SceneSource(kScene, "v.toml", "."), options());
+  s.edit("dust.g", "0.8");
+  s.edit("stars.0.luminosity_lsun", "5e4");
+  CameraSettings camera = s.scene().camera;
+  camera.position = {2.5f, -2.0f, 1.4f};
+  camera.fov_deg = 33.3;
+  const Frame shown = frame_of(s, camera);
+  DisplaySettings display;
+  display.stretch = Stretch::Log;
+  const std::string text = s.saved_scene_text(camera, display, {});
+  const Scene saved = load_scene_text(text, "saved.toml", ".");
+  EXPECT_TRUE(saved.display == display);
+  RenderOptions o;
+  o.table_photons = 1000;
+  const RenderOutput rendered = render_scene(saved, o);
+  EXPECT_EQ(rendered.image.pixels, shown.image.pixels);
+}
+
+TEST_F(ViewerSession, AStarsTemperatureReplacesItsClass) {
+  Session s(SceneSource(kScene, "v.toml", "."), options());
+  const CameraSettings camera = s.scene().camera;
+  const Frame hot = frame_of(s, camera);
+  // The viewer's edit: the star's entry whole, with a temperature instead of the class.
+  s.edit("stars.0", "{name = \"star 0\", position = [1, 1, 1], luminosity_lsun = 2e5, temperature_K = 5770}");
+  const Frame cool = frame_of(s, camera);
+  EXPECT_TRUE(s.status().error.empty()) << s.status().error;
+  s.sync_scene();
+  EXPECT_EQ(s.scene().stars[0].temperature_K, 5770);
+  EXPECT_EQ(s.scene().stars[0].spectral_class, "");
+  // The same bolometric luminosity: a Sun-like star puts far more of it in B, V and R than an O5V star.
+  EXPECT_GT(total(cool.image), 2 * total(hot.image));
+}
+
+TEST_F(ViewerSession, TheTruthAccumulatesWhileTheCameraRests) {
+  Session s(SceneSource(kScene, "v.toml", "."), options());
+  const CameraSettings camera = s.scene().camera;
+  frame_of(s, camera);
+  s.set_truth(true);
+  std::optional<TruthFrame> six;
+  for (int i = 0; i < 600 && !(six && six->passes >= 6); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    six = s.truth();
+  }
+  s.set_truth(false);
+  ASSERT_TRUE(six && six->passes >= 6);
+  EXPECT_EQ(six->spp, 2 * six->passes);
+  // The accumulation is the mean of `nebula truth` passes with seeds 1, 2, ..., its variance
+  // the sum of theirs over K^2.
+  Scene scene = s.scene();
+  scene.camera = camera;
+  const int K = six->passes;
+  std::vector<double> mean(six->mean.pixels.size(), 0.0);
+  double var = 0, first_var = 0, first_sum = 0;
+  for (int k = 1; k <= K; ++k) {
+    TruthOptions t;
+    t.spp = 2;
+    t.seed = uint64_t(k);
+    const TruthRenderOutput out = truth_scene(scene, t);
+    for (size_t i = 0; i < mean.size(); ++i) {
+      mean[i] += out.image.pixels[i] / double(K);
+      var += out.variance.pixels[i] / (double(K) * K);
+      if (k == 1) first_var += out.variance.pixels[i], first_sum += out.image.pixels[i];
+    }
+  }
+  double diff = 0, sum = 0;
+  for (size_t i = 0; i < mean.size(); ++i) {
+    diff += std::fabs(mean[i] - six->mean.pixels[i]);
+    sum += mean[i];
+  }
+  EXPECT_NEAR(six->noise, std::sqrt(var) / sum, 1e-4 * six->noise);
+  // The noise falls as 1/sqrt(K) against one pass (a third of slack for the variance estimates' own noise).
+  EXPECT_LT(six->noise, 1.33 * std::sqrt(first_var) / first_sum / std::sqrt(double(K)));
+  EXPECT_LT(diff, 1e-5 * sum);  // float rounding of the running mean only
+}
+
+TEST_F(ViewerSession, RecordedKeyframesAreSavedAsACameraPath) {
+  Session s(SceneSource(kScene, "v.toml", "."), options());
+  CameraKeyframe a, b;
+  a.time = 0;
+  a.position = {1, -2.5f, 1};
+  a.look_at = b.look_at = {1, 1, 1};
+  b.time = 2;
+  b.position = {3, -2, 1.5f};
+  b.fov_deg = 30;
+  const Scene saved = load_scene_text(s.saved_scene_text(s.scene().camera, {}, {a, b}), "saved.toml", ".");
+  ASSERT_TRUE(saved.camera_path.has_value());
+  ASSERT_EQ(saved.camera_path->keys.size(), 2u);
+  EXPECT_EQ(saved.camera_path->keys[1].position.x, 3.0f);
+  EXPECT_EQ(saved.camera_path->keys[1].fov_deg, 30);
+}
+
+TEST_F(ViewerSession, TheWindowShowsWhatAPngHolds) {
+  if (!openimageio_available()) GTEST_SKIP() << "PNG needs OpenImageIO";
+  Session s(SceneSource(kScene, "v.toml", "."), options());
+  const Frame f = frame_of(s, s.scene().camera);
+  DisplaySettings d;
+  d.stretch = Stretch::Asinh;
+  d.auto_exposure = true;
+  const Rgba8 rgba = display_image(f.image, 0.02, d, f.metadata);
+  ImageMetadata m = f.metadata;
+  m.display = d;
+  m.exposure = 0.02;
+  write_image(f.image, path("f.png"), m, false);
+  const Image png = read_any_image(path("f.png"));
+  ASSERT_EQ(png.width, rgba.width);
+  for (int y = 0; y < png.height; ++y)
+    for (int x = 0; x < png.width; ++x)
+      for (int c = 0; c < 3; ++c)
+        ASSERT_EQ(int(std::lround(png.at(c, x, y) * 255)), int(rgba.pixels[(size_t(y) * png.width + x) * 4 + c]))
+            << x << " " << y << " " << c;
+}
+
+}  // namespace
+}  // namespace nebula::viewer
