@@ -145,16 +145,7 @@ void write_png(const Image& image, const ImageMetadata& metadata, const std::str
   // The channels shown (weighted sums of the bands), then the display transform;
   // auto exposure looks at the channels shown.
   const size_t plane = image.plane_size();
-  std::vector<float> shown(plane * size_t(channels));
-  for (size_t i = 0; i < plane; ++i)
-    for (int c = 0; c < channels; ++c) {
-      float v = 0.0f;
-      for (size_t b = 0; b < colours.size(); ++b) {
-        const PngColour& w = colours[b];
-        v += (c == 0 ? w.red : c == 1 ? w.green : w.blue) * image.pixels[b * plane + i];
-      }
-      shown[size_t(c) * plane + i] = v;
-    }
+  const std::vector<float> shown = shown_channels(image, colours);
   const double exposure = display.auto_exposure ? auto_exposure_of(shown, display, metadata.exposure) : metadata.exposure;
   spec.attribute("nebula:tone_map", std::string(to_string(display.stretch)) + " stretch of value x exposure " +
                                         exact_text(exposure) + (display.auto_exposure ? " (auto)" : "") +

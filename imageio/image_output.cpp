@@ -225,6 +225,22 @@ void check_image_format(const std::string& path) {
                 "-DNEBULA_OPENIMAGEIO=ON), use .h5 or .fits");
 }
 
+std::vector<float> shown_channels(const Image& image, const std::vector<PngColour>& colours) {
+  const int channels = image.bands.size() == 1 ? 1 : 3;
+  const size_t plane = image.plane_size();
+  std::vector<float> shown(plane * size_t(channels));
+  for (size_t i = 0; i < plane; ++i)
+    for (int c = 0; c < channels; ++c) {
+      float v = 0.0f;
+      for (size_t b = 0; b < colours.size(); ++b) {
+        const PngColour& w = colours[b];
+        v += (c == 0 ? w.red : c == 1 ? w.green : w.blue) * image.pixels[b * plane + i];
+      }
+      shown[size_t(c) * plane + i] = v;
+    }
+  return shown;
+}
+
 std::vector<PngColour> png_colours(const Image& image, const ImageMetadata& metadata) {
   const size_t n = image.bands.size();
   if (n == 1) return {PngColour{1, 1, 1}};

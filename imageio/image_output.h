@@ -128,6 +128,9 @@ struct PngColour {
   float red = 0, green = 0, blue = 0;
 };
 std::vector<PngColour> png_colours(const Image& image, const ImageMetadata& metadata);
+// The channels shown (1 for a single band, else red, green, blue), plane by
+// plane: each the weighted sum of the bands by `colours` (PNG and the viewer).
+std::vector<float> shown_channels(const Image& image, const std::vector<PngColour>& colours);
 
 // Where the variance of an image lives (the ground truth writes one beside its
 // image; comparisons look for it): "out.h5" -> "out.var.h5".

@@ -12,16 +12,7 @@ Rgba8 display_image(const Image& image, double exposure, const DisplaySettings& 
   const size_t plane = image.plane_size();
   const bool grey = image.bands.size() == 1;
   const int channels = grey ? 1 : 3;
-  std::vector<float> shown(plane * size_t(channels));
-  for (size_t i = 0; i < plane; ++i)
-    for (int c = 0; c < channels; ++c) {
-      float v = 0.0f;
-      for (size_t b = 0; b < colours.size(); ++b) {
-        const PngColour& w = colours[b];
-        v += (c == 0 ? w.red : c == 1 ? w.green : w.blue) * image.pixels[b * plane + i];
-      }
-      shown[size_t(c) * plane + i] = v;
-    }
+  const std::vector<float> shown = shown_channels(image, colours);
   if (display.auto_exposure) exposure = auto_exposure_of(shown, display, exposure);
   Rgba8 out;
   out.width = image.width;
