@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/device_array.h"
+#include "core/device_mirror.h"
 
 namespace nebula {
 
@@ -18,6 +19,19 @@ class DevicePlacement {
   const T* place(const std::vector<T>& v) {
     bytes_ += v.size() * sizeof(T);
     return upload(v);
+  }
+  // The array's device mirror, uploaded into it first when it holds none:
+  // an array that does not change is uploaded once for every later kernel.
+  template <class T>
+  const T* place(const std::vector<T>& v, DeviceMirror& mirror) {
+    bytes_ += v.size() * sizeof(T);
+    if (!mirror.holds(v.size() * sizeof(T))) {
+      auto array = std::make_shared<DeviceArray<T>>(v);
+      mirror.device = array->get();
+      mirror.bytes = v.size() * sizeof(T);
+      mirror.owner = std::move(array);
+    }
+    return static_cast<const T*>(mirror.device);
   }
   // The same for an array made while assembling (not counted in bytes()).
   template <class T>

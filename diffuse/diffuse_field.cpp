@@ -8,14 +8,28 @@
 
 namespace nebula {
 
-void DiffuseField::pack() {
-  const size_t n = size_t(n_coeffs()), count = cells.count();
-  packed.assign(count * n * 4, 0.0f);
-  for (size_t b = 0; b < coeffs.size() && b < size_t(kMaxBands); ++b) {
-    if (coeffs[b].empty()) continue;
-    if (coeffs[b].size() != count * n) throw Error("diffuse field: band " + std::to_string(b) + " has the wrong size");
-    for (size_t i = 0; i < count * n; ++i) packed[i * 4 + b] = coeffs[b][i];
-  }
+void DiffuseField::allocate(size_t bands) {
+  if (bands > size_t(kMaxBands)) throw Error("diffuse field: at most " + std::to_string(kMaxBands) + " bands");
+  packed.assign(cells.count() * size_t(n_coeffs()) * 4, 0.0f);
+  response.assign(bands, {});
+  response_tau_max.assign(bands, 0.0f);
+  device_packed.reset();
+}
+
+std::vector<float> DiffuseField::band_coeffs(size_t b) const {
+  const size_t n = cells.count() * size_t(n_coeffs());
+  if (b >= size_t(kMaxBands) || packed.size() != n * 4) throw Error("diffuse field: no band " + std::to_string(b));
+  std::vector<float> out(n);
+  for (size_t i = 0; i < n; ++i) out[i] = packed[i * 4 + b];
+  return out;
+}
+
+void DiffuseField::set_band_coeffs(size_t b, const std::vector<float>& coeffs) {
+  const size_t n = cells.count() * size_t(n_coeffs());
+  if (b >= size_t(kMaxBands) || packed.size() != n * 4 || coeffs.size() != n)
+    throw Error("diffuse field: band " + std::to_string(b) + " has the wrong size");
+  for (size_t i = 0; i < n; ++i) packed[i * 4 + b] = coeffs[i];
+  device_packed.reset();
 }
 
 size_t DiffuseField::bytes() const {
@@ -30,8 +44,8 @@ DiffuseView DiffuseField::view() const {
   v.shift = shift;
   v.degree = degree;
   v.packed = packed.data();
-  for (size_t b = 0; b < coeffs.size() && b < size_t(kMaxBands); ++b) {
-    if (coeffs[b].empty()) continue;
+  for (size_t b = 0; b < response.size() && b < size_t(kMaxBands); ++b) {
+    if (response[b].empty()) continue;
     v.has[b] = true;
     v.response[b] = response[b].data();
     v.rows[b] = static_cast<int>(response[b].size() / size_t(diffuse_response_stride(degree)));

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "core/bands.h"
+#include "core/device_mirror.h"
 #include "core/grid.h"
 #include "core/hd.h"
 #include "diffuse/spherical_harmonics.h"
@@ -164,21 +165,29 @@ decltype(auto) dispatch_diffuse_degree(int degree, F&& f) {
   return f(std::integral_constant<int, 4>{});
 }
 
-// The owning field.
+// The owning field. Its harmonics live in `packed`, the kernels' layout; a
+// band has a field when it has a response.
 struct DiffuseField {
   GridShape cells;
   int shift = 0;   // a cell spans 2^shift voxels per axis
   int degree = 3;
-  std::vector<std::vector<float>> coeffs;    // [band]: [cell * n_coeffs + k]; empty where the band has no field
-  std::vector<float> packed;                 // the bands interleaved for kernels (pack())
-  std::vector<std::vector<float>> response;  // [band]: per table row, p*_0..p*_degree, the peak, padding (delta_m_response)
+  std::vector<float> packed;                 // [(cell * n_coeffs + k) * 4 + band], 0 for bands without a field
+  std::vector<std::vector<float>> response;  // [band]: per table row, p*_0..p*_degree, the peak, padding (delta_m_response); empty: no field
   std::vector<float> response_tau_max;       // [band]
+  // The CUDA bake leaves its device copy of `packed` here and the CUDA
+  // marchers read it (core/device_mirror.h); changing `packed` resets it.
+  mutable DeviceMirror device_packed;
 
   int n_coeffs() const { return sh_count(degree); }
-  // Builds `packed` from `coeffs`: [(cell * n_coeffs + k) * 4 + band], 0 for bands without a field.
-  void pack();
+  size_t n_bands() const { return response.size(); }
+  bool has_band(size_t b) const { return b < response.size() && !response[b].empty(); }
+  // Sizes the arrays for `bands` bands, harmonics all zero and no band with a field yet.
+  void allocate(size_t bands);
+  // Band b's harmonics, [cell * n_coeffs + k] (copied out of / into `packed`).
+  std::vector<float> band_coeffs(size_t b) const;
+  void set_band_coeffs(size_t b, const std::vector<float>& coeffs);
   size_t bytes() const;       // what a kernel reads: packed and the responses
-  DiffuseView view() const;   // host pointers (pack() first)
+  DiffuseView view() const;   // host pointers
 };
 
 // p_0 .. p_n of every row of `table` (row-major, n + 1 per row): the table's

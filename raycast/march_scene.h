@@ -29,9 +29,9 @@ const StarView* place_star_views(const std::vector<BakedStar>& stars, int n_band
 template <class Place>
 DiffuseView place_diffuse(const DiffuseField& field, Place& place) {
   DiffuseView v = field.view();
-  v.packed = place.place(field.packed);
-  for (size_t b = 0; b < field.coeffs.size() && b < size_t(kMaxBands); ++b)
-    if (!field.coeffs[b].empty()) v.response[b] = place.place(field.response[b]);
+  v.packed = place.place(field.packed, field.device_packed);
+  for (size_t b = 0; b < field.n_bands() && b < size_t(kMaxBands); ++b)
+    if (field.has_band(b)) v.response[b] = place.place(field.response[b]);
   return v;
 }
 
