@@ -98,7 +98,7 @@ std::vector<DiffusePassResult> diffuse_passes_cuda(const std::vector<DiffusePass
 template <class Place>
 DiffusePhotonScene assemble_photon_scene(const DiffusePassInputs& in, Place& place) {
   DiffusePhotonScene s;
-  s.medium.density = {in.density->shape, place.place(in.density->tau_v)};
+  s.medium.density = {in.density->shape, place.place(in.density->tau_v, in.density->device_tau_v)};
   s.medium.majorant = in.majorant->view();
   s.medium.majorant.max_tau_v = place.place(in.majorant->max_tau_v);
   s.medium.majorant.min_tau_v = place.place(in.majorant->min_tau_v);

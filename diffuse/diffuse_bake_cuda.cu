@@ -56,6 +56,17 @@ class SharedUploads {
     held_[v.data()] = {array, array->get()};
     return array->get();
   }
+  template <class T>
+  const T* place(const std::vector<T>& v, DeviceMirror& mirror) {
+    if (!mirror.holds(v.size() * sizeof(T))) {
+      auto array = std::make_shared<DeviceArray<T>>(v);
+      mirror.device = array->get();
+      mirror.bytes = array->bytes();
+      mirror.owner = std::move(array);
+    }
+    bytes_ += mirror.bytes;
+    return static_cast<const T*>(mirror.device);
+  }
   size_t bytes() const { return bytes_; }
 
  private:

@@ -20,7 +20,8 @@ const StarView* place_star_views(const std::vector<BakedStar>& stars, int n_band
   for (size_t k = 0; k < stars.size(); ++k) {
     views[k].position = stars[k].position;
     for (int b = 0; b < n_bands; ++b) views[k].power[b] = stars[k].power[size_t(b)];
-    views[k].depth_v = place.place(*stars[k].depth_v);
+    views[k].depth_v = stars[k].depth_mirror ? place.place(*stars[k].depth_v, *stars[k].depth_mirror)
+                                             : place.place(*stars[k].depth_v);
   }
   return place.keep(std::move(views));
 }
@@ -40,7 +41,7 @@ template <class Place>
 MarchScene assemble_march_scene(const RenderInputs& in, Place& place) {
   validate(in);
   MarchScene scene{};
-  scene.density = {in.density->shape, place.place(in.density->tau_v)};
+  scene.density = {in.density->shape, place.place(in.density->tau_v, in.density->device_tau_v)};
   scene.n_bands = static_cast<int>(in.bands.size());
   scene.min_transmittance = in.min_transmittance;
   scene.footprint = in.camera.footprint();
