@@ -4,6 +4,7 @@
 // placement. For .cu files only.
 #include <cstddef>
 #include <memory>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -24,14 +25,20 @@ class DevicePlacement {
   // an array that does not change is uploaded once for every later kernel.
   template <class T>
   const T* place(const std::vector<T>& v, DeviceMirror& mirror) {
-    bytes_ += v.size() * sizeof(T);
-    if (!mirror.holds(v.size() * sizeof(T))) {
-      auto array = std::make_shared<DeviceArray<T>>(v);
-      mirror.device = array->get();
-      mirror.bytes = v.size() * sizeof(T);
-      mirror.owner = std::move(array);
-    }
-    return static_cast<const T*>(mirror.device);
+    return place_mirrored(mirror, v.size(), [&]() -> const std::vector<T>& { return v; });
+  }
+  // The same for an array that may live on the device only (`count`
+  // elements): fetch() gives the host copy, called only to upload.
+  template <class Fetch>
+  auto place_mirrored(DeviceMirror& mirror, size_t count, Fetch&& fetch) {
+    using T = typename std::decay_t<decltype(fetch())>::value_type;
+    bytes_ += count * sizeof(T);
+    const DeviceMirror::Copy copy = mirror.get_or_upload(count * sizeof(T), [&] {
+      auto array = std::make_shared<DeviceArray<T>>(fetch());
+      return DeviceMirror::Copy{array, array->get()};
+    });
+    held_.push_back(copy.owner);
+    return static_cast<const T*>(copy.device);
   }
   // The same for an array made while assembling (not counted in bytes()).
   template <class T>

@@ -27,6 +27,11 @@ class HostPlacement {
   const T* place(const std::vector<T>& v, DeviceMirror&) {
     return place(v);
   }
+  // An array that may live on the device only: fetch() gives the host copy.
+  template <class Fetch>
+  auto place_mirrored(DeviceMirror&, size_t, Fetch&& fetch) {
+    return place(fetch());
+  }
   // An array made while assembling (per-star views, say), kept alive here.
   template <class T>
   const T* keep(std::vector<T> v) {

@@ -90,7 +90,6 @@ DiffuseField bake_diffuse(const DensityGrid& density, const std::vector<DiffuseB
   DiffuseField field;
   field.degree = o.degree;
   field.cells = diffuse_cells(density.shape, o.cells, &field.shift);
-  field.allocate(bands.size());
   DiffuseBakeStats st;
   st.noise.assign(bands.size(), -1.0);
   const MajorantGrid majorant = build_majorant_grid(density, o.majorant_block);
@@ -129,9 +128,12 @@ DiffuseField bake_diffuse(const DensityGrid& density, const std::vector<DiffuseB
     units.push_back(total / double(o.photons) * cells.voxel / kDiffuseFixedScale);
   }
   std::vector<DiffusePassResult> results;
-  if (backend == Backend::Cuda && !passes.empty()) {
+  const bool on_device = backend == Backend::Cuda && !passes.empty();
+  field.allocate(bands.size(), /*on_host=*/!on_device);
+  if (on_device) {
     results = diffuse_passes_cuda(passes, units, o.photons, grid, &field);
   } else {
+    std::vector<float>& packed = field.packed_for_writing();
     for (size_t p = 0; p < passes.size(); ++p) {
       DiffusePassResult pass = diffuse_pass_cpu(passes[p], o.photons, progress);
       const size_t b = passes[p].band_index;
@@ -142,7 +144,7 @@ DiffuseField bake_diffuse(const DensityGrid& density, const std::vector<DiffuseB
             const double volume = diffuse_cell_volume(grid, field.shift, x, y, z);
             for (int k = 0; k < n_coeffs; ++k) {
               const size_t i = cell * size_t(n_coeffs) + size_t(k);
-              field.packed[i * 4 + b] = diffuse_coefficient(pass.sums[i], units[p], volume);
+              packed[i * 4 + b] = diffuse_coefficient(pass.sums[i], units[p], volume);
             }
           }
       });

@@ -86,8 +86,8 @@ NEBULA_HD float diffuse_coefficient(unsigned long long sum, double unit, double 
 }
 
 // Every band's pass on the GPU with the grid uploaded once; the harmonics are
-// made from the sums there and written into field->packed, whose device copy
-// stays in field->device_packed for the marchers. Per pass (the order of
+// made from the sums there and stay there, in field->device_packed (the
+// field has no host copy until host_packed() fetches one). Per pass (the order of
 // `passes`): its l = 0 sums and odd sums (`sums` holds only k = 0) for the
 // noise, counters and time.
 std::vector<DiffusePassResult> diffuse_passes_cuda(const std::vector<DiffusePassInputs>& passes,

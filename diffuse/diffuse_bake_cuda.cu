@@ -58,14 +58,13 @@ class SharedUploads {
   }
   template <class T>
   const T* place(const std::vector<T>& v, DeviceMirror& mirror) {
-    if (!mirror.holds(v.size() * sizeof(T))) {
+    const DeviceMirror::Copy copy = mirror.get_or_upload(v.size() * sizeof(T), [&] {
       auto array = std::make_shared<DeviceArray<T>>(v);
-      mirror.device = array->get();
-      mirror.bytes = array->bytes();
-      mirror.owner = std::move(array);
-    }
-    bytes_ += mirror.bytes;
-    return static_cast<const T*>(mirror.device);
+      return DeviceMirror::Copy{array, array->get()};
+    });
+    bytes_ += v.size() * sizeof(T);
+    held_[v.data()] = {copy.owner, copy.device};
+    return static_cast<const T*>(copy.device);
   }
   size_t bytes() const { return bytes_; }
 
@@ -122,10 +121,9 @@ std::vector<DiffusePassResult> diffuse_passes_cuda(const std::vector<DiffusePass
     r.device_bytes = device.bytes() + sums.bytes() + odd.bytes() + l0.bytes() + packed->bytes();
     out.push_back(std::move(r));
   }
-  packed->download(field->packed.data());
-  field->device_packed.device = packed->get();
-  field->device_packed.bytes = packed->bytes();
-  field->device_packed.owner = std::move(packed);
+  const size_t bytes = packed->bytes();
+  const void* on_device = packed->get();
+  field->device_packed.set({std::move(packed), on_device}, bytes);
   return out;
 }
 

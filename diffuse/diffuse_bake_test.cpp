@@ -172,8 +172,8 @@ TEST(DiffuseBake, TheSameFieldOnOneThreadOrMany) {
     tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
     one = bake_diffuse(grid, {band}, stars, o, Backend::Cpu);
   }
-  ASSERT_EQ(many.packed.size(), one.packed.size());
-  for (size_t i = 0; i < one.packed.size(); ++i) ASSERT_EQ(many.packed[i], one.packed[i]) << i;
+  ASSERT_EQ(many.host_packed().size(), one.host_packed().size());
+  for (size_t i = 0; i < one.host_packed().size(); ++i) ASSERT_EQ(many.host_packed()[i], one.host_packed()[i]) << i;
 }
 
 // The field's noise estimate (its two halves) falls as 1 / sqrt(photons).

@@ -29,8 +29,9 @@ const StarView* place_star_views(const std::vector<BakedStar>& stars, int n_band
 // A kernel view of a diffuse field with its arrays placed.
 template <class Place>
 DiffuseView place_diffuse(const DiffuseField& field, Place& place) {
-  DiffuseView v = field.view();
-  v.packed = place.place(field.packed, field.device_packed);
+  DiffuseView v = field.view(/*without_harmonics=*/true);
+  v.packed = place.place_mirrored(field.device_packed, field.packed_size(),
+                                  [&]() -> const std::vector<float>& { return field.host_packed(); });
   for (size_t b = 0; b < field.n_bands() && b < size_t(kMaxBands); ++b)
     if (field.has_band(b)) v.response[b] = place.place(field.response[b]);
   return v;

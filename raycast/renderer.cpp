@@ -37,7 +37,7 @@ void validate(const RenderInputs& in) {
     if (f->n_bands() != in.bands.size() || f->cells.nx != (g.nx + edge - 1) / edge ||
         f->cells.ny != (g.ny + edge - 1) / edge || f->cells.nz != (g.nz + edge - 1) / edge)
       throw Error("render: the diffuse field was baked for another grid or other bands");
-    if (f->packed.size() != f->cells.count() * size_t(f->n_coeffs()) * 4)
+    if (!f->has_harmonics())
       throw Error("render: the diffuse field's harmonics have the wrong size");
   }
 }
