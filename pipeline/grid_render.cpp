@@ -165,11 +165,11 @@ RenderOutput render_prepared(const PreparedGrid& p, const CameraSettings& settin
   if (p.options.progress && p.options.backend == Backend::Cpu)
     bar = std::make_unique<Progress>("render", uint64_t(in.camera.height));
   in.progress = bar.get();
-  const PyramidResult pyramid = render_pyramid(in, p.pyramid, p.options.backend);
+  PyramidResult pyramid = render_pyramid(in, p.pyramid, p.options.backend);
   if (bar) bar->finish();
 
   RenderOutput out;
-  out.image = box_downsample(pyramid.image, k);
+  out.image = box_downsample(std::move(pyramid.image), k);
   out.report = p.report;
   out.report.camera = to_string(settings.projection);
   out.report.width = camera.width;
