@@ -57,22 +57,32 @@ Image render_map(const AxialMap& map, const std::vector<std::string>& bands, con
   return render_axial(in, backend);
 }
 
-// The straightened input and the re-rendered reconstruction side by side, one
-// exposure for both.
-Image side_by_side(const StraightImage& s, const Image& again) {
-  Image out(2 * s.nx + 4, 2 * s.nr, s.bands);
-  float peak = 0;
+// Three panels, 4 pixels apart: the straightened input, the reconstructed
+// map (mirrored about the axis, the way it is seen; its own scale) and the
+// map re-rendered (the input's scale).
+Image side_by_side(const StraightImage& s, const AxialMap& map, const Image& again) {
+  const int gap = 4;
+  Image out(3 * s.nx + 2 * gap, 2 * s.nr, s.bands);
+  float peak = 0, map_peak = 0;
   for (size_t b = 0; b < s.bands.size(); ++b)
     for (int ix = 0; ix < s.nx; ++ix)
       for (int j = 0; j < s.nr; ++j) {
         const float v = s.column(int(b), ix)[j];
         out.at(int(b), ix, s.nr - 1 - j) = out.at(int(b), ix, s.nr + j) = v;
         peak = std::max(peak, v);
+        map_peak = std::max(map_peak, map.emission[b][map.index(ix, j)]);
+      }
+  for (size_t b = 0; b < s.bands.size(); ++b)
+    for (int ix = 0; ix < s.nx; ++ix)
+      for (int j = 0; j < s.nr; ++j) {
+        const float v = map_peak > 0 ? peak * map.emission[b][map.index(ix, j)] / map_peak : 0.0f;
+        out.at(int(b), s.nx + gap + ix, s.nr - 1 - j) = out.at(int(b), s.nx + gap + ix, s.nr + j) = v;
       }
   for (size_t b = 0; b < s.bands.size(); ++b)
     for (int y = 0; y < again.height; ++y)
-      for (int x = 0; x < again.width; ++x) out.at(int(b), s.nx + 4 + x, y) = again.at(int(b), x, y);
-  for (float& v : out.pixels) v = peak > 0 ? v / peak : v;
+      for (int x = 0; x < again.width; ++x) out.at(int(b), 2 * (s.nx + gap) + x, y) = again.at(int(b), x, y);
+  // A picture: noise below 0 shows as black.
+  for (float& v : out.pixels) v = std::max(0.0f, peak > 0 ? v / peak : v);
   return out;
 }
 
@@ -108,6 +118,14 @@ void run_reconstruct(const std::string& input, const std::vector<double>& axis_v
     const StraightImage straight = straighten_image(image, s.axis, s.length, s.radius);
     ReconstructReport r;
     const AxialMap map = reconstruct_any(straight, s, &r);
+    // Every output made before any is written: a failure leaves nothing behind.
+    Image panels;
+    if (!compare.empty()) {
+      const Image again = render_map(map, image.bands, s.method == ReconstructMethod::Absorb ? s.extinction_ratio
+                                                                                             : std::vector<float>{},
+                                     s.step_texels, Backend::Cpu);
+      panels = side_by_side(straight, map, again);
+    }
     write_axial_map_hdf5(map, image.bands, out, force);
     std::printf("reconstructed %s: map %d x %d texels (one per pixel), %d band%s, method %s on %s\n", input.c_str(),
                 r.nx, r.nr, r.bands, r.bands == 1 ? "" : "s", to_string(s.method),
@@ -118,11 +136,13 @@ void run_reconstruct(const std::string& input, const std::vector<double>& axis_v
                 "stopped at the iteration limit\n",
                 r.side_rms, r.smoothness, r.iterations, r.not_converged, r.not_converged == 1 ? "" : "s");
     if (!compare.empty()) {
-      const Image again = render_map(map, image.bands, s.method == ReconstructMethod::Absorb ? s.extinction_ratio
-                                                                                             : std::vector<float>{},
-                                     s.step_texels, Backend::Cpu);
-      write_image(side_by_side(straight, again), compare, ImageMetadata{}, force);
-      std::printf("wrote %s (input, straightened | the map re-rendered)\n", compare.c_str());
+      try {
+        write_image(panels, compare, ImageMetadata{}, force);
+      } catch (const Error&) {
+        std::filesystem::remove(out);  // nothing half-done: the map goes with its picture
+        throw;
+      }
+      std::printf("wrote %s (the input straightened | the map, own scale | the map re-rendered)\n", compare.c_str());
     }
   });
   std::printf("wrote %s: render it with [axial] file = \"%s\", emission_prefix = \"emission_\", "
@@ -214,7 +234,7 @@ void add_reconstruct_command(CLI::App& app) {
   cmd->add_option("--step", o->step, "the march step in texels the map will be rendered with")->capture_default_str();
   cmd->add_option("--extinction-ratios", o->ratios, "absorb: A_b / A_V per image band (default 1 each)")
       ->delimiter(',');
-  cmd->add_option("--compare", o->compare, "also write the straightened input beside the map re-rendered (an image)");
+  cmd->add_option("--compare", o->compare, "also write an image: the straightened input | the map | the map re-rendered");
   cmd->add_flag("--force", o->force, "overwrite the outputs");
   cmd->callback([o] {
     run_reconstruct(o->input, o->axis, o->out, o->method, o->backend, o->length, o->radius, o->smoothness, o->step,
