@@ -18,7 +18,9 @@
 // direction set is reset to the coordinates every sweep, so a block keeps
 // O(nr) numbers instead of Powell's nr^2 direction set. Line minimisation by
 // quadratic interpolation through f(-delta), f(0), f(+delta) (Powell 1964),
-// clamped so that e stays >= 0, accepted only when f decreases. Coarse to
+// clamped so that e stays >= 0, accepted only when f decreases; f along a
+// line is exactly quadratic, so one pass of three sums gives every trial
+// value (one block reduction per direction on the GPU). Coarse to
 // fine: texels grouped by `coarsest`, then halves of it, down to single texels.
 #include <math.h>
 
@@ -57,23 +59,10 @@ struct SerialTeam {
   NEBULA_HD int size() const { return 1; }
   NEBULA_HD void sync() {}
   template <int K>
-  NEBULA_HD void sum(float (&)[K]) {}
+  NEBULA_HD void sum(float (&)[K]) {}  // one thread: its sums are the totals
 };
 
 namespace powell_detail {
-
-// sum_j (r_j + alpha d_j)^2 over j < rows, for K values of alpha at once.
-template <class Team, int K>
-NEBULA_HD void trial_sums(Team& team, const float* r, const float* d, int rows, const float (&alpha)[K],
-                          float (&out)[K]) {
-  for (int k = 0; k < K; ++k) out[k] = 0.0f;
-  for (int j = team.rank(); j < rows; j += team.size())
-    for (int k = 0; k < K; ++k) {
-      const float v = r[j] + alpha[k] * d[j];
-      out[k] += v * v;
-    }
-  team.sum(out);
-}
 
 // The minimiser of the parabola through (-delta, fm), (0, f0), (delta, fp),
 // or the better end point when it opens downwards; clamped to [lo, hi].
@@ -87,21 +76,19 @@ NEBULA_HD float parabola_minimum(float fm, float f0, float fp, float delta, floa
   return alpha < lo ? lo : (alpha > hi ? hi : alpha);
 }
 
-// One line minimisation along the direction whose image is d (rows < rows):
-// f restricted to it is f_rest + sum_{j < rows} (r_j + alpha d_j)^2. Returns
-// the accepted step (0 when none lowers f) and the new f.
-template <class Team>
-NEBULA_HD float line_minimum(Team& team, const float* r, const float* d, int rows, float f, float delta, float lo,
-                             float hi, float& f_new) {
-  float alpha3[3] = {0.0f, -delta, delta}, s3[3];
-  trial_sums(team, r, d, rows, alpha3, s3);
-  const float f_rest = f - s3[0];
-  const float alpha = parabola_minimum(s3[1], s3[0], s3[2], delta, lo, hi);
+// One line minimisation along a direction whose image is d. The synthesis
+// along the line, r + alpha d, makes f quadratic in alpha: with the sums
+// s = {sum r^2, sum r d, sum d^2} over the rows d touches, f(alpha) = f -
+// s0 + (s0 + 2 alpha s1 + alpha^2 s2) for every trial alpha. Powell's
+// interpolation through f(-delta), f(0), f(delta) then gives the step,
+// clamped to [lo, hi] (non-negativity) and taken only when f falls. Returns
+// the step (0: none) and the new f.
+NEBULA_HD float line_minimum(const float (&s)[3], float f, float delta, float lo, float hi, float& f_new) {
+  auto trial = [&](float alpha) { return f - s[0] + (s[0] + 2.0f * alpha * s[1] + alpha * alpha * s[2]); };
+  const float alpha = parabola_minimum(trial(-delta), f, trial(delta), delta, lo, hi);
   f_new = f;
   if (!(alpha != 0.0f)) return 0.0f;
-  float a1[1] = {alpha}, s1[1];
-  trial_sums(team, r, d, rows, a1, s1);
-  const float candidate = f_rest + s1[0];
+  const float candidate = trial(alpha);
   if (!(candidate < f)) return 0.0f;
   f_new = candidate;
   return alpha;
@@ -110,23 +97,24 @@ NEBULA_HD float line_minimum(Team& team, const float* r, const float* d, int row
 }  // namespace powell_detail
 
 // Fits e >= 0 to the column p (n values). Every thread of the team calls it
-// with the same arguments; work lies in memory the team shares. Returns the
+// with the same arguments; work lies in memory the team shares. A thread owns
+// the rows j = rank + k size of r, g and ad (it alone writes and reads them),
+// so only e and d, read across rows, need the team's barriers. Returns the
 // sweeps run in all.
 template <class Team>
 NEBULA_HD int powell_column(Team& team, const ColumnSystem& A, const float* p, const PowellSettings& s,
                             const PowellWork& w) {
   using namespace powell_detail;
   const int n = A.n;
-  for (int j = team.rank(); j < n; j += team.size()) {
-    w.e[j] = 0.0f;
-    w.r[j] = -p[j];
-  }
-  team.sync();
   float f;
   {
-    float sq[1];
-    float zero[1] = {0.0f};
-    trial_sums(team, w.r, w.r, n, zero, sq);
+    float sq[1] = {0.0f};
+    for (int j = team.rank(); j < n; j += team.size()) {
+      w.e[j] = 0.0f;
+      w.r[j] = -p[j];
+      sq[0] += p[j] * p[j];
+    }
+    team.sum(sq);
     f = sq[0];
   }
   int sweeps_run = 0;
@@ -141,48 +129,56 @@ NEBULA_HD int powell_column(Team& team, const ColumnSystem& A, const float* p, c
         const int i1 = i0 + g < n ? i0 + g : n;
         int rows = 0;
         for (int i = i0; i < i1; ++i) rows = A.row_end[i] > rows ? A.row_end[i] : rows;
+        // The group's common value, read before the barrier in team.sum: after
+        // it, other threads may already write the group's texels.
+        const float level = w.e[i0];
+        float sums[3] = {0.0f, 0.0f, 0.0f};
         for (int j = team.rank(); j < rows; j += team.size()) {
-          float v = 0.0f;
+          float v = 0.0f;  // the group's image: sum of its texels' columns of A
           for (int i = i0; i < i1; ++i) v += A.a[size_t(i) * n + j];
           w.g[j] = v;
+          sums[0] += w.r[j] * w.r[j];
+          sums[1] += w.r[j] * v;
+          sums[2] += v * v;
         }
-        team.sync();
-        float norm[1] = {0.0f};
-        for (int j = team.rank(); j < rows; j += team.size()) norm[0] += w.g[j] * w.g[j];
-        team.sum(norm);
-        if (!(norm[0] > 0.0f)) continue;
-        const float level = w.e[i0];  // the group's common value
-        const float delta = fabsf(level) + sqrtf(f / norm[0]);
+        team.sum(sums);
+        if (!(sums[2] > 0.0f)) continue;
+        const float delta = fabsf(level) + sqrtf(f / sums[2]);
         float f_new;
-        const float alpha = line_minimum(team, w.r, w.g, rows, f, delta, -level, 1e30f, f_new);
+        const float alpha = line_minimum(sums, f, delta, -level, 1e30f, f_new);
         if (alpha != 0.0f) {
           for (int j = team.rank(); j < rows; j += team.size()) w.r[j] += alpha * w.g[j];
           for (int i = i0 + team.rank(); i < i1; i += team.size()) w.e[i] = fmaxf(0.0f, level + alpha);
           f = f_new;
         }
-        team.sync();
       }
       // Powell's extrapolation along the sweep's displacement d, bounded so
       // that e + alpha d stays >= 0.
+      team.sync();
       for (int j = team.rank(); j < n; j += team.size()) w.d[j] = w.e[j] - w.e0[j];
       team.sync();
+      float sums[3] = {0.0f, 0.0f, 0.0f};
       for (int j = team.rank(); j < n; j += team.size()) {
         float v = 0.0f;
         for (int i = A.col_begin[j]; i < n; ++i) v += A.a[size_t(i) * n + j] * w.d[i];
         w.ad[j] = v;
+        sums[0] += w.r[j] * w.r[j];
+        sums[1] += w.r[j] * v;
+        sums[2] += v * v;
       }
-      team.sync();
-      // Step limits: alpha in [lo, hi] keeps e + alpha d >= 0. Found by every
-      // thread over the whole column (reads only), so no reduction is needed.
+      // Step limits: alpha in [lo, hi] keeps e + alpha d >= 0. Every thread
+      // scans the whole column before the barrier in team.sum (after it e
+      // changes), so no reduction is needed.
       float lo = -1e30f, hi = 1e30f;
       for (int i = 0; i < n; ++i) {
         const float di = w.d[i];
         if (di < 0.0f) hi = fminf(hi, w.e[i] / -di);
         if (di > 0.0f) lo = fmaxf(lo, -w.e[i] / di);
       }
-      if (hi > lo && hi > 0.0f) {
+      team.sum(sums);
+      if (sums[2] > 0.0f && hi > lo && hi > 0.0f) {
         float f_new;
-        const float alpha = line_minimum(team, w.r, w.ad, n, f, 1.0f, lo, hi, f_new);
+        const float alpha = line_minimum(sums, f, 1.0f, lo, hi, f_new);
         if (alpha != 0.0f) {
           for (int j = team.rank(); j < n; j += team.size()) {
             w.r[j] += alpha * w.ad[j];
@@ -190,8 +186,8 @@ NEBULA_HD int powell_column(Team& team, const ColumnSystem& A, const float* p, c
           }
           f = f_new;
         }
-        team.sync();
       }
+      team.sync();
       if (!(f_start - f > s.tolerance * f_start)) break;
     }
   }

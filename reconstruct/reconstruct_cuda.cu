@@ -16,24 +16,29 @@ namespace {
 
 constexpr int kThreads = 128;
 
-// A CUDA block as powell_column's team: sums reduce through shared memory
-// and every thread gets the same totals.
+// A CUDA block as powell_column's team: sums reduce within each warp by
+// shuffles, then across the warps through shared memory; every thread gets
+// the same totals.
 struct BlockTeam {
-  float* partial;  // kThreads x 4 floats of shared memory
+  float* partial;  // 4 x (kThreads / 32) floats of shared memory
   __device__ int rank() const { return threadIdx.x; }
   __device__ int size() const { return blockDim.x; }
   __device__ void sync() { __syncthreads(); }
   template <int K>
   __device__ void sum(float (&v)[K]) {
     static_assert(K <= 4, "at most 4 sums at once");
-    for (int k = 0; k < K; ++k) partial[k * kThreads + threadIdx.x] = v[k];
+    constexpr int kWarps = kThreads / 32;
+    const int lane = threadIdx.x & 31, warp = threadIdx.x >> 5;
+    for (int k = 0; k < K; ++k)
+      for (int offset = 16; offset > 0; offset /= 2) v[k] += __shfl_down_sync(0xffffffffu, v[k], offset);
+    if (lane == 0)
+      for (int k = 0; k < K; ++k) partial[k * kWarps + warp] = v[k];
     __syncthreads();
-    for (int stride = kThreads / 2; stride > 0; stride /= 2) {
-      if (int(threadIdx.x) < stride)
-        for (int k = 0; k < K; ++k) partial[k * kThreads + threadIdx.x] += partial[k * kThreads + threadIdx.x + stride];
-      __syncthreads();
+    for (int k = 0; k < K; ++k) {
+      float total = 0.0f;
+      for (int w = 0; w < kWarps; ++w) total += partial[k * kWarps + w];  // the same order in every thread
+      v[k] = total;
     }
-    for (int k = 0; k < K; ++k) v[k] = partial[k * kThreads];
     __syncthreads();  // every thread has read the totals before the next sum writes
   }
 };
@@ -43,7 +48,7 @@ __global__ void __launch_bounds__(kThreads) powell_kernel(ColumnSystem system, c
   extern __shared__ float shared[];
   const int n = system.n;
   BlockTeam team{shared};
-  float* w = shared + 4 * kThreads;
+  float* w = shared + 4 * (kThreads / 32);
   const PowellWork work{w, w + n, w + 2 * n, w + 3 * n, w + 4 * n, w + 5 * n};
   const size_t column = blockIdx.x;
   const int run = powell_column(team, system, profiles + column * n, s, work);
@@ -56,7 +61,7 @@ __global__ void __launch_bounds__(kThreads) powell_kernel(ColumnSystem system, c
 std::vector<float> powell_columns_cuda(const ColumnProjection& projection, const std::vector<float>& profiles,
                                        int count, const PowellSettings& settings, long long* sweeps) {
   const int n = projection.n;
-  const size_t shared = (4 * size_t(kThreads) + 6 * size_t(n)) * sizeof(float);
+  const size_t shared = (4 * size_t(kThreads / 32) + 6 * size_t(n)) * sizeof(float);
   int device = 0, limit = 0;
   NEBULA_CUDA_CHECK(cudaGetDevice(&device));
   NEBULA_CUDA_CHECK(cudaDeviceGetAttribute(&limit, cudaDevAttrMaxSharedMemoryPerBlockOptin, device));
