@@ -46,8 +46,9 @@ TEST(ReconstructGpu, ProjectionMatchesTheCpu) {
   const ColumnProjection gpu = build_projection(n, step, Backend::Cuda);
   // The same march; float contraction (FMA) on the device may move a sample
   // position across a ring edge. Such a sample moves its fraction (at most
-  // one step, 0.5 texel) from one entry of a row to another, and leaves the
-  // row's total (the chord through the whole cylinder) unchanged but for
+  // one step, 0.5 texel) from one entry of a row to another; a ray crosses
+  // each edge twice, so an entry changes by at most two steps. The row's
+  // total (the chord through the whole cylinder) stays the same but for
   // rounding: 2 K eps_32 of it with K = 2 n / step samples.
   const double k = 2.0 * n / step;
   int moved = 0;
@@ -55,14 +56,14 @@ TEST(ReconstructGpu, ProjectionMatchesTheCpu) {
     double total_cpu = 0, total_gpu = 0;
     for (int i = 0; i < n; ++i) {
       const float d = std::fabs(gpu.at(j, i) - cpu.at(j, i));
-      EXPECT_LE(d, step + 1e-5f) << "row " << j << " ring " << i;
+      EXPECT_LE(d, 2.0f * step + 1e-5f) << "row " << j << " ring " << i;
       moved += d > 1e-5f;
       total_cpu += cpu.at(j, i);
       total_gpu += gpu.at(j, i);
     }
     EXPECT_NEAR(total_gpu, total_cpu, 2.0 * k * 0x1p-24 * total_cpu) << "row " << j;
   }
-  EXPECT_LT(moved, n * n / 100);  // a sample on an edge is rare: under 1% of the entries
+  EXPECT_LT(moved, n * n / 100);  // rare: under 1% of the entries (the axial GPU test's bound for pixels)
   std::printf("projection %d: %d of %d entries differ between GPU and CPU; relative difference %.3g\n", n, moved,
               n * n, relative(gpu.a, cpu.a));
 }
