@@ -170,7 +170,10 @@ DiffuseField bake_diffuse(const DensityGrid& density, const std::vector<DiffuseB
       l0_sums = &l0;
     }
     st.noise[b] = field_noise(*l0_sums, pass.odd, cells, grid, field.shift);
-    field.response[b] = delta_m_response(*bands[b].table, o.degree);
+    // Bands sharing a table (one albedo and g) share its response.
+    for (size_t q = 0; q < p && field.response[b].empty(); ++q)
+      if (bands[passes[q].band_index].table == bands[b].table) field.response[b] = field.response[passes[q].band_index];
+    if (field.response[b].empty()) field.response[b] = delta_m_response(*bands[b].table, o.degree);
     field.response_tau_max[b] = static_cast<float>(bands[b].table->tau_max());
   }
   st.field_bytes = field.bytes();

@@ -1,5 +1,7 @@
 #include "montecarlo/majorant_grid.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <string>
 
@@ -20,7 +22,8 @@ MajorantGrid build_majorant_grid(const DensityGrid& d, int block) {
   m.shape.voxel = g.voxel * block;
   m.max_tau_v.assign(m.shape.count(), 0.0f);
   m.min_tau_v.assign(m.shape.count(), 0.0f);
-  for (int bz = 0; bz < m.shape.nz; ++bz)
+  // Slabs of blocks in parallel: each block is written once, by one thread.
+  tbb::parallel_for(0, m.shape.nz, [&](int bz) {
     for (int by = 0; by < m.shape.ny; ++by)
       for (int bx = 0; bx < m.shape.nx; ++bx) {
         float hi = 0.0f, lo = 3.0e38f;
@@ -37,6 +40,7 @@ MajorantGrid build_majorant_grid(const DensityGrid& d, int block) {
         m.max_tau_v[m.shape.index(bx, by, bz)] = hi;
         m.min_tau_v[m.shape.index(bx, by, bz)] = std::max(0.0f, std::min(lo, hi));
       }
+  });
   return m;
 }
 
