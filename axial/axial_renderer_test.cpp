@@ -191,7 +191,7 @@ TEST(AxialRender, RefusesBadInputs) {
     parse_axial_skip("fast", "--skip");
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("--skip: 'fast' is not a skip mode (known: naive, empty, global_max, omega, "
-                                         "omega_multi, distance)"),
+                                         "omega_multi, distance, thesis_omega_max, thesis_omega_large, thesis_omega_multi)"),
               std::string::npos)
         << e.what();
   }

@@ -587,10 +587,13 @@ AxialSpec Parser::parse_axial(const toml::table& root, const std::vector<std::st
   }
   if (const toml::node* v = t.get("skip")) {
     a.skip = string(*v, "axial.skip");
-    const char* modes[] = {"naive", "empty", "global_max", "omega", "omega_multi", "distance"};
+    const char* modes[] = {"naive",    "empty",           "global_max",         "omega",
+                           "omega_multi", "distance",     "thesis_omega_max",   "thesis_omega_large",
+                           "thesis_omega_multi"};
     if (std::find_if(std::begin(modes), std::end(modes), [&](const char* m) { return a.skip == m; }) == std::end(modes))
-      fail("axial.skip",
-           "'" + a.skip + "' is not a skip mode (known: naive, empty, global_max, omega, omega_multi, distance)");
+      fail("axial.skip", "'" + a.skip +
+                             "' is not a skip mode (known: naive, empty, global_max, omega, omega_multi, distance, "
+                             "thesis_omega_max, thesis_omega_large, thesis_omega_multi)");
   }
   return a;
 }
