@@ -208,19 +208,27 @@ AxialMap synthetic_axial_map(const std::string& name, int nx, int nr, float texe
         if (s > 0.03f && s < 0.97f && std::fabs(v - wall) < 0.012f) tau = 3.0f;
         if (s < 0.03f && v < 0.05f) glow = 1.0f;  // a small emitting waist
       } else if (name == "lopsided") {
-        // A dense cloud off the map's centre with a fainter tail to one side.
-        const float a = (u - 0.32f) * aspect, b = v;
-        const float d2 = a * a / 0.08f + b * b / 0.25f;
-        const float tail = (u > 0.32f) ? std::exp(-((u - 0.32f) * aspect) / 0.6f) * std::exp(-b * b / 0.05f) : 0.0f;
-        const float rho = 4.0f * std::exp(-d2) + 1.5f * tail;
-        if (rho > 0.02f) tau = rho;
-        if (d2 < 0.15f) glow = 2.0f;
+        // Calabash-like (OH 231.8+4.2): a dense core off the map's centre
+        // with two unequal lobes along the axis, a long plume widening to one
+        // side and a short stub to the other; nothing outside them, so most
+        // texels are empty (docs/axial.md, "Maps", gives the fractions).
+        const float u0 = 0.3f, a = (u - u0) * aspect, b = v;
+        const float d2 = a * a / 0.01f + b * b / 0.02f;
+        float rho = d2 < 1.0f ? 4.0f * (1.0f - 0.5f * d2) : 0.0f;
+        if (u > u0 && u < 0.95f && b < 0.04f + 0.35f * (u - u0)) rho += 1.5f * std::exp(-(u - u0) * aspect / 0.8f);
+        if (u < u0 && u > 0.12f && b < 0.03f + 0.4f * (u0 - u)) rho += 1.0f * std::exp(-(u0 - u) * aspect / 0.3f);
+        tau = rho;
+        if (d2 < 0.3f) glow = 2.0f;
       } else if (name == "shells") {
-        // Three concentric spherical shells about the map's centre.
+        // Round, after NGC 6826: a thick bright inner shell (emitting), a
+        // thinner one around it and a faint outer halo shell, all inside the
+        // sphere of 0.48 radii about the map's centre (so they fit a map as
+        // long as it is wide), hollow between the shells.
         const float a = (u - 0.5f) * aspect, rho = std::sqrt(a * a + v * v);
-        for (float shell : {0.3f, 0.55f, 0.8f})
-          if (std::fabs(rho - shell) < 0.03f) tau = 2.0f;
-        if (std::fabs(rho - 0.3f) < 0.03f) glow = 1.0f;
+        if (std::fabs(rho - 0.18f) < 0.05f) tau = 2.0f;
+        if (std::fabs(rho - 0.31f) < 0.03f) tau = 1.5f;
+        if (std::fabs(rho - 0.45f) < 0.025f) tau = 0.5f;
+        if (std::fabs(rho - 0.18f) < 0.05f) glow = 1.0f;
       } else if (name == "full") {
         tau = 0.5f + 0.5f * u;
         glow = 0.2f;
