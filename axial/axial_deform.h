@@ -49,11 +49,12 @@ struct AxialDeformView {
   Vec3 e1{1, 0, 0}, e2{0, 1, 0};  // frame perpendicular to the axis: the angle's zero and quarter turn
 };
 
-// The colour factor of band b at q (relative to the map's origin), in [1 - A, 1].
-NEBULA_HD float colour_factor(const AxialDeformView& d, Vec3 q, int band) {
-  NoiseParams n = d.colour_noise;
-  n.seed = n.seed + 0x61c88647u * static_cast<uint32_t>(band + 1);  // one field per band
-  return 1.0f - n.amplitude * noise01(n, d.inv_length * q);
+// The colour factors of the first n_bands bands at q (relative to the map's
+// origin), each in [1 - A, 1]: one noise field per band (noise01_bands).
+NEBULA_HD void colour_factors(const AxialDeformView& d, Vec3 q, int n_bands, float* out) {
+  noise01_bands(d.colour_noise, d.inv_length * q, n_bands, out);
+  for (int b = 0; b < 4; ++b)
+    if (b < n_bands) out[b] = 1.0f - d.colour_noise.amplitude * out[b];
 }
 
 // The diamond angle in [0, 4) of the offset (u, v); 0 on the axis.

@@ -35,7 +35,7 @@ double peak(const Image& im) {
 // over every lattice vertex near p of (0.5 - |d|^2)^4 (g . d) where positive,
 // d the unskewed offset from the vertex. Equal to simplex3 when only the
 // corners of p's tetrahedron lie within the radius (what makes it continuous).
-float simplex_by_definition(Vec3 p, uint32_t seed) {
+float simplex_by_definition(Vec3 p, uint32_t seed, int band = 0) {
   const float s = (p.x + p.y + p.z) / 3.0f;
   const int i0 = int(std::floor(p.x + s)), j0 = int(std::floor(p.y + s)), k0 = int(std::floor(p.z + s));
   double n = 0;
@@ -47,7 +47,8 @@ float simplex_by_definition(Vec3 p, uint32_t seed) {
         const double a = 0.5 - dx * dx - dy * dy - dz * dz;
         if (a <= 0) continue;
         n += a * a * a * a *
-             noise_detail::edge_gradient(noise_detail::lattice_hash(i, j, k, seed), float(dx), float(dy), float(dz));
+             noise_detail::edge_gradient(noise_detail::lattice_hash(i, j, k, seed) >> (8 * band), float(dx), float(dy),
+                                         float(dz));
       }
   return float(std::fmax(-1.0, std::fmin(1.0, kSimplexScale * n)));
 }
@@ -58,6 +59,30 @@ TEST(AxialNoise, SimplexIsTheSumOverItsCorners) {
   for (int n = 0; n < 20000; ++n) {
     const Vec3 p{u(rng), u(rng), u(rng)};
     ASSERT_NEAR(simplex3(p, 11), simplex_by_definition(p, 11), 2e-5f) << p.x << " " << p.y << " " << p.z;
+    // The per-band fields: each its own gradients (byte b of the corner's hash).
+    float bands[4];
+    simplex3_bands(p, 11, 4, bands);
+    for (int b = 0; b < 4; ++b) ASSERT_NEAR(bands[b], simplex_by_definition(p, 11, b), 2e-5f) << b;
+  }
+}
+
+// The per-band colour fields differ from each other (independent gradients),
+// and field 0 of every kind is the single field.
+TEST(AxialNoise, BandFieldsAreDistinct) {
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<float> u(-3.0f, 3.0f);
+  for (NoiseKind kind : kKinds) {
+    NoiseParams n;
+    n.kind = kind;
+    int differs = 0;
+    for (int i = 0; i < 1000; ++i) {
+      const Vec3 p{u(rng), u(rng), u(rng)};
+      float v[4];
+      noise01_bands(n, p, 4, v);
+      ASSERT_EQ(v[0], noise01(n, p)) << to_string(kind);
+      differs += v[1] != v[0] && v[2] != v[0] && v[3] != v[1];
+    }
+    EXPECT_GT(differs, 900) << to_string(kind);
   }
 }
 

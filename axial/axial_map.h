@@ -154,9 +154,9 @@ DensityGrid voxelize_axial_map(const AxialMap& map, float voxel, std::vector<std
 // their empty fractions): "bipolar" (two thin-walled lobes, like M2-9: mostly
 // empty), "lopsided" (like the Calabash nebula: a dense off-centre core with a
 // long lobe to one side and a short one to the other, most texels empty),
-// "shells" (round, like NGC 6826: three concentric shells inside 0.48 radii
-// of the centre, the inner one thick and emitting), "empty" and "full" (dust
-// and emission in every texel). `tau_scale` multiplies tau_v
+// "shells" (round, like NGC 6826: three concentric shells, the inner one
+// emitting), "empty", "full" (dust and emission in every texel) and "cloud"
+// (the lopsided map before issue 15: a dense cloud with a tail). `tau_scale` multiplies tau_v
 // (which is given per map radius, so the optical depths do not depend on
 // nr); emission gets `n_emission_bands` planes (0: none). The map is
 // nx x nr texels of edge `texel`, its axis through `origin` along `axis`.

@@ -237,16 +237,21 @@ NEBULA_HD float distance_reach(int d, float texel, float inv_speed, float eps) {
   return (float(d - 1) * texel - eps) * inv_speed;
 }
 
-// The thesis' omega_max at a sample in column ix at distance r_lo (its
-// smallest possible read radius) from the axis: the ray's parameter interval
-// [t_entry, t_exit] (clipped to [t_in, t_out]) inside the x-slab of the
-// largest max-tree node holding ix whose height lies below r_lo; its length
-// in whole samples, 0 when no node does (the sample is below a column's top).
-NEBULA_HD int thesis_omega_max(const AxialView& m, const AxialRay& ray, int ix, float r_lo, float t_in, float t_out,
-                               float inv_h, float eps) {
+// The thesis' omega_max at a sample at t in column ix whose smallest read
+// radius is r_lo: the current max-tree node is the largest node holding ix
+// whose height h lies below the sample (h l + eps <= r_lo); its interval is
+// the part of the ray inside the node's x-slab and outside the cylinder of
+// radius h l / shrink (where no sample can read a non-empty texel of the
+// node's columns), clipped to [t_in, t_out]; omega_max = t_exit - t_entry of
+// the piece holding t, in whole samples (0 when no node lies below the
+// sample). Float arithmetic: the step it suggests is checked before it is
+// taken, so its rounding changes speed, never the image.
+NEBULA_HD int thesis_omega_max(const AxialView& m, const AxialRay& ray, int ix, float r_lo, float t, float t_in,
+                               float t_out, float inv_h, float eps, float shrink) {
   for (int level = m.n_levels - 1; level >= 0; --level) {
     const int node = ix >> level;
-    if (!(float(m.tree[m.level_offset[level] + node]) * m.texel + eps <= r_lo)) continue;
+    const int height = m.tree[m.level_offset[level] + node];
+    if (!(float(height) * m.texel + eps <= r_lo)) continue;
     const int c0 = node << level, c1 = (node + 1) << level;
     const float xa = float(c0) * m.texel, xb = float(c1 < m.nx ? c1 : m.nx) * m.texel;
     float t_entry = t_in, t_exit = t_out;
@@ -259,6 +264,18 @@ NEBULA_HD int thesis_omega_max(const AxialView& m, const AxialRay& ray, int ix, 
       }
       t_entry = fmaxf(t_entry, ta);
       t_exit = fminf(t_exit, tb);
+    }
+    if (height > 0) {
+      // Where the ray is inside the node's cylinder: (ca, cb), the roots of |w0 + t wd| = rho.
+      const float rho = float(height) * m.texel / shrink;
+      const float A = dot(ray.wd, ray.wd), B = dot(ray.w0, ray.wd), C = dot(ray.w0, ray.w0) - rho * rho;
+      const float disc = B * B - A * C;
+      if (A > 0.0f && disc > 0.0f) {
+        const float root = sqrtf(disc), ca = (-B - root) / A, cb = (-B + root) / A;
+        if (t <= ca) t_exit = fminf(t_exit, ca);
+        else if (t >= cb) t_entry = fmaxf(t_entry, cb);
+        else return 0;  // within rounding of the cylinder: no step
+      }
     }
     const float n = floorf((t_exit - t_entry) * inv_h);
     return n >= 1.0f ? static_cast<int>(fminf(n, 1e8f)) : 0;
@@ -422,10 +439,10 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
           if (tau_v > 0.0f) add_axial_diffuse_light(s, q, x, r, tau_v, to_eye, source, peak);
         if constexpr (kDeform)
           if (deform.colour && !dark) {
+            colour_factors(deform, q, s.n_bands, lower);
             NEBULA_UNROLL
             for (int b = 0; b < kMaxBands; ++b) {
               if (b >= s.n_bands) break;
-              lower[b] = colour_factor(deform, q, b);
               source[b] *= lower[b];
               peak[b] *= lower[b];
             }
@@ -469,7 +486,7 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
       const int rest = k_end - 1 - k;
       if (rest < 1) continue;
       const int omega_max =
-          axial_detail::thesis_omega_max(m, ray, ix, r * shrink, t_in, t_out, inv_h, eps);
+          axial_detail::thesis_omega_max(m, ray, ix, r * shrink, t, t_in, t_out, inv_h, eps, shrink);
       const int first = skip == int(AxialSkip::ThesisOmegaLarge) ? 5 : 0;
       const int last = skip == int(AxialSkip::ThesisOmegaMulti) ? 5 : first;
       for (int halving = first; halving <= last; ++halving) {

@@ -76,8 +76,12 @@ NEBULA_HD int floor_int(float v) {
 
 }  // namespace noise_detail
 
-// Simplex noise in [-1, 1] (clamped; the unclamped range is about +-1).
-NEBULA_HD float simplex3(Vec3 p, uint32_t seed) {
+// Simplex noise in [-1, 1] (clamped; the unclamped range is about +-1) for
+// n_bands (1 to 4) fields at once: they share the lattice and the corners'
+// weights; field b takes its corner gradients from byte b of the corner's
+// hash, so the fields are independent for the cost of about one. Field 0 is
+// simplex3(p, seed).
+NEBULA_HD void simplex3_bands(Vec3 p, uint32_t seed, int n_bands, float* out) {
   using namespace noise_detail;
   constexpr float F3 = 1.0f / 3.0f, G3 = 1.0f / 6.0f;  // skew to the cubic lattice and back
   const float s = (p.x + p.y + p.z) * F3;
@@ -99,62 +103,92 @@ NEBULA_HD float simplex3(Vec3 p, uint32_t seed) {
   const float cy[4] = {y0, y0 - float(j1) + G3, y0 - float(j2) + 2.0f * G3, y0 - 1.0f + 3.0f * G3};
   const float cz[4] = {z0, z0 - float(k1) + G3, z0 - float(k2) + 2.0f * G3, z0 - 1.0f + 3.0f * G3};
   const int di[4] = {0, i1, i2, 1}, dj[4] = {0, j1, j2, 1}, dk[4] = {0, k1, k2, 1};
-  float n = 0.0f;
+  float n[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   for (int c = 0; c < 4; ++c) {
     float a = 0.5f - cx[c] * cx[c] - cy[c] * cy[c] - cz[c] * cz[c];
     if (a > 0.0f) {
       a *= a;
-      n += a * a * edge_gradient(lattice_hash(i + di[c], j + dj[c], k + dk[c], seed), cx[c], cy[c], cz[c]);
+      a *= a;
+      const uint32_t h = lattice_hash(i + di[c], j + dj[c], k + dk[c], seed);
+      for (int b = 0; b < 4; ++b)
+        if (b < n_bands) n[b] += a * edge_gradient(h >> (8 * b), cx[c], cy[c], cz[c]);
     }
   }
-  const float v = kSimplexScale * n;
-  return fminf(1.0f, fmaxf(-1.0f, v));
+  for (int b = 0; b < 4; ++b)
+    if (b < n_bands) out[b] = fminf(1.0f, fmaxf(-1.0f, kSimplexScale * n[b]));
+}
+
+NEBULA_HD float simplex3(Vec3 p, uint32_t seed) {
+  float v;
+  simplex3_bands(p, seed, 1, &v);
+  return v;
 }
 
 // Worley's F1 in [0, 1]: distance to the nearest of one hashed feature point
 // per unit cell, over the 27 cells around p (F1 < 1 always lies among them);
-// clamped at 1.
-NEBULA_HD float cellular3(Vec3 p, uint32_t seed) {
+// clamped at 1. For n_bands fields at once: field b places its points with
+// its own hash of the cell (field 0: cellular3(p, seed)).
+NEBULA_HD void cellular3_bands(Vec3 p, uint32_t seed, int n_bands, float* out) {
   using namespace noise_detail;
   const int i = floor_int(p.x), j = floor_int(p.y), k = floor_int(p.z);
   const float fx = p.x - float(i), fy = p.y - float(j), fz = p.z - float(k);
-  float best = 3.0f;
+  float best[4] = {3.0f, 3.0f, 3.0f, 3.0f};
   for (int dk = -1; dk <= 1; ++dk)
     for (int dj = -1; dj <= 1; ++dj)
       for (int di = -1; di <= 1; ++di) {
-        const uint32_t h = lattice_hash(i + di, j + dj, k + dk, seed);
-        const uint32_t h2 = mix32(h);
-        // The feature point's place in its cell: three 10-bit fractions.
-        const float ox = float(h & 1023u) * (1.0f / 1024.0f), oy = float((h >> 10) & 1023u) * (1.0f / 1024.0f),
-                    oz = float(h2 & 1023u) * (1.0f / 1024.0f);
-        const float ex = float(di) + ox - fx, ey = float(dj) + oy - fy, ez = float(dk) + oz - fz;
-        const float d2 = ex * ex + ey * ey + ez * ez;
-        best = d2 < best ? d2 : best;
+        uint32_t h = lattice_hash(i + di, j + dj, k + dk, seed);
+        for (int b = 0; b < 4; ++b) {
+          if (b >= n_bands) break;
+          if (b > 0) h = mix32(h + 0x9e3779b9u);
+          const uint32_t h2 = mix32(h);
+          // The feature point's place in its cell: three 10-bit fractions.
+          const float ox = float(h & 1023u) * (1.0f / 1024.0f), oy = float((h >> 10) & 1023u) * (1.0f / 1024.0f),
+                      oz = float(h2 & 1023u) * (1.0f / 1024.0f);
+          const float ex = float(di) + ox - fx, ey = float(dj) + oy - fy, ez = float(dk) + oz - fz;
+          const float d2 = ex * ex + ey * ey + ez * ez;
+          best[b] = d2 < best[b] ? d2 : best[b];
+        }
       }
-  return fminf(1.0f, sqrtf(best));
+  for (int b = 0; b < 4; ++b)
+    if (b < n_bands) out[b] = fminf(1.0f, sqrtf(best[b]));
 }
 
-// The noise of `n` at p (p already in the noise's units: frequency applied
-// here), in [0, 1]. Octaves above 8 are treated as 8.
-NEBULA_HD float noise01(const NoiseParams& n, Vec3 p) {
+NEBULA_HD float cellular3(Vec3 p, uint32_t seed) {
+  float v;
+  cellular3_bands(p, seed, 1, &v);
+  return v;
+}
+
+// n_bands (1 to 4) fields of the noise `n` at p (frequency applied here), in
+// [0, 1]; field 0 is noise01(n, p). Octaves above 8 are treated as 8.
+NEBULA_HD void noise01_bands(const NoiseParams& n, Vec3 p, int n_bands, float* out) {
   p = n.frequency * p;
-  if (n.kind == NoiseKind::Simplex) return 0.5f + 0.5f * simplex3(p, n.seed);
-  const int octaves = n.octaves < 1 ? 1 : (n.octaves > 8 ? 8 : n.octaves);
-  float sum = 0.0f, weight = 0.0f, w = 1.0f;
+  const int octaves = n.kind == NoiseKind::Simplex ? 1 : (n.octaves < 1 ? 1 : (n.octaves > 8 ? 8 : n.octaves));
+  float sum[4] = {0.0f, 0.0f, 0.0f, 0.0f}, v[4];
+  float weight = 0.0f, w = 1.0f;
   for (int o = 0; o < octaves; ++o) {
     const uint32_t seed = n.seed + 0x3c6ef372u * static_cast<uint32_t>(o);  // octaves decorrelated
-    float v;
-    if (n.kind == NoiseKind::Fbm) v = simplex3(p, seed);
-    else if (n.kind == NoiseKind::Turbulence) v = fabsf(simplex3(p, seed));
-    else v = cellular3(p, seed);
-    sum += w * v;
+    if (n.kind == NoiseKind::Cellular) cellular3_bands(p, seed, n_bands, v);
+    else simplex3_bands(p, seed, n_bands, v);
+    for (int b = 0; b < 4; ++b)
+      if (b < n_bands) sum[b] += w * (n.kind == NoiseKind::Turbulence ? fabsf(v[b]) : v[b]);
     weight += w;
     w *= n.gain;
     p = n.lacunarity * p;
   }
-  const float v = sum / weight;  // fbm in [-1, 1], turbulence and cellular in [0, 1]
-  const float u = n.kind == NoiseKind::Fbm ? 0.5f + 0.5f * v : v;
-  return fminf(1.0f, fmaxf(0.0f, u));
+  for (int b = 0; b < 4; ++b)
+    if (b < n_bands) {
+      const float s = sum[b] / weight;  // simplex and fbm in [-1, 1], turbulence and cellular in [0, 1]
+      const float u = (n.kind == NoiseKind::Simplex || n.kind == NoiseKind::Fbm) ? 0.5f + 0.5f * s : s;
+      out[b] = fminf(1.0f, fmaxf(0.0f, u));
+    }
+}
+
+// The noise of `n` at p (p in the noise's units before the frequency), in [0, 1].
+NEBULA_HD float noise01(const NoiseParams& n, Vec3 p) {
+  float v;
+  noise01_bands(n, p, 1, &v);
+  return v;
 }
 
 }  // namespace nebula

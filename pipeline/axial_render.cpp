@@ -74,6 +74,8 @@ RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
   RunReport& report = out.report;
   report = begin_report(scene, sb, "axial", o.backend, scatters);
   report.mode = std::string("axial ") + to_string(skip) + " step " + to_text(spec.step_texels) + " texel";
+  if (spec.colour_deform.on) report.mode += ", colour deformation " + spec.colour_deform.kind;
+  if (spec.shape_deform.on) report.mode += ", shape deformation " + spec.shape_deform.kind;
   report.tables = tables.report;
 
   // Stars on the axis: one 2D bake each.

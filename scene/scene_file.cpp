@@ -535,10 +535,10 @@ AxialSpec Parser::parse_axial(const toml::table& root, const std::vector<std::st
   only("nr", "synthetic");
   if (a.source == "synthetic") {
     a.synthetic = string(*t.get("synthetic"), "axial.synthetic");
-    const char* names[] = {"bipolar", "lopsided", "shells", "empty", "full"};
+    const char* names[] = {"bipolar", "lopsided", "shells", "empty", "full", "cloud"};
     if (std::find_if(std::begin(names), std::end(names), [&](const char* n) { return a.synthetic == n; }) ==
         std::end(names))
-      fail("axial.synthetic", "'" + a.synthetic + "' is not a built-in map (known: bipolar, lopsided, shells, empty, full)");
+      fail("axial.synthetic", "'" + a.synthetic + "' is not a built-in map (known: bipolar, lopsided, shells, empty, full, cloud)");
     for (const char* key : {"nx", "nr"})
       if (const toml::node* v = t.get(key)) {
         const int n = small_integer(*v, std::string("axial.") + key);
