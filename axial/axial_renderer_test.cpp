@@ -98,11 +98,12 @@ TEST(AxialRender, UniformCylinderMatchesTheClosedForm) {
 // the angle, the 2D vs. 3D bake paths and, per cell of depth x, the rule's
 // x / (1 - e^{-x}) dependence on the cell size (so the maps here are thin per
 // texel, tau_v <= 0.075; thick texels differ by that factor). Measured
-// (48 x 16 map, 48^2 image, 60 degrees): relative L1 0.125 (cloud, the
-// lopsided map before issue 15) and 0.092 (shells before issue 15 thickened
-// them; 0.050 since, flux ratio 1.031), image flux ratio 1.055 and 1.057;
-// 0.185 and 0.101 with voxel = texel, 0.100 and 0.084 with voxel = texel / 3
-// (cloud converges). Bounds: L1 < 0.15, flux within 8%.
+// (48 x 16 map, 48^2 image, 60 degrees): relative L1 0.042 (cloud, the
+// lopsided map before issue 15) and 0.050 (shells, thickened by issue 15;
+// 0.080 before), image flux ratio 1.038 and 1.031 (2026-11-24; the figures
+// of an earlier version, 0.125 and 0.092 at l/2, 0.185 and 0.101 at l, 0.100
+// and 0.084 at l/3, showed the cloud converging). Bounds: L1 < 0.15, flux
+// within 8%.
 TEST(AxialRender, VoxelizedGridRendersTheSameNebula) {
   for (const std::string name : {"cloud", "shells"}) {
     AxialScene s(name, 48, 16, Vec3{0, 0, 1}, 50.0f, 0.3f);

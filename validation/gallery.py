@@ -22,8 +22,9 @@ map lit by a star at its waist, seen along the axis, at 60 degrees and
 across it, then the shells and the lopsided map at 60 degrees (no truth).
 --study axial_deform (Khalass 2021 section 3.2): the lopsided (Calabash-like)
 map, its render at 60 degrees without deformations and with colour and shape
-deformations of each noise kind (simplex, fbm, turbulence, cellular); the
-map itself (tau_v, written by `nebula bench axial --write-maps`) first.
+deformations of each noise kind (simplex, fbm, turbulence, cellular), single
+scattering (render.multiple_scattering = "none"); the map itself (tau_v,
+written by `nebula bench axial --write-maps`) first.
 --study axial_ms: validation/scenes/axial_lopsided_thick.toml (an axial map,
 optical depths up to about 5 from the star on its axis) without light
 scattered between texels and with the diffuse field (the default), beside
@@ -86,15 +87,15 @@ STUDIES = {
         ("lopsided", "lopsided, 60 degrees", ["--set", 'axial.synthetic="lopsided"']),
     ]),
     "axial_deform": ("axial_deform.png",
-                     "Asymmetry (after Khalass 2021, section 3.2): the lopsided map without and with colour and "
-                     "shape deformations, 60 degrees, same exposure",
+                     "Asymmetry (after Khalass 2021, section 3.2): the lopsided map, plain and deformed (60 degrees)",
                      AXIAL_SCENE, None, [
         ("plain", "no deformation", []),
     ] + [
-        (kind, f"{kind}: colour 0.6,\nshape pull up to 0.3",
-         ["--set", f'axial.colour_deform.kind="{kind}"', "--set", "axial.colour_deform.amplitude=0.6",
-          "--set", f'axial.shape_deform.kind="{kind}"', "--set", "axial.shape_deform.amplitude=0.3",
-          "--set", "axial.shape_deform.frequency=6"])
+        (kind, f"{kind}: colour 0.8,\nshape pull up to 0.4",
+         ["--set", f'axial.colour_deform.kind="{kind}"', "--set", "axial.colour_deform.amplitude=0.8",
+          "--set", "axial.colour_deform.frequency=6",
+          "--set", f'axial.shape_deform.kind="{kind}"', "--set", "axial.shape_deform.amplitude=0.4",
+          "--set", "axial.shape_deform.frequency=8"])
         for kind in ("simplex", "fbm", "turbulence", "cellular")
     ]),
     "axial_ms": ("axial_diffuse.png",
@@ -230,7 +231,8 @@ def main():
         common = ["--set", 'axial.synthetic="lopsided"', "--set", "axial.nx=512", "--set", "axial.nr=512",
                   "--set", "axial.length_pc=4.0", "--set", "axial.origin=[0.0, 0.0, -2.0]",
                   "--set", "axial.emission_scale=0.05",
-                  "--set", "camera.position=[10.392, 0.0, 6.0]", "--set", "camera.fov_deg=22"]
+                  "--set", "camera.position=[10.392, 0.0, 6.0]", "--set", "camera.fov_deg=22",
+                  "--set", 'render.multiple_scattering="none"']  # single scattering: the shapes show, quickly
         variants = [(k, t, common + extra) for k, t, extra in variants]
         run([args.nebula, "bench", "axial", "--backend", "cpu", "--maps", "lopsided", "--map-size", "512",
              "--image", "8", "--inclinations", "0", "--modes", "naive", "--repeats", "1", "--deform", "off",
@@ -290,7 +292,7 @@ def main():
         elif args.study == "fig12":
             axes[0].set_ylabel(FAST_LABEL, fontsize=10)
     fig.suptitle(suptitle)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, 0.9) if args.study == "axial_deform" else None)
     montage = os.path.join(args.out, montage_name)
     fig.savefig(montage + ".tmp.png")
     os.replace(montage + ".tmp.png", montage)
