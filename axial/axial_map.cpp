@@ -223,7 +223,7 @@ AxialMap synthetic_axial_map(const std::string& name, int nx, int nr, float texe
         if (u > u0 && u < 0.95f && b < 0.06f + 0.55f * (u - u0)) rho += 1.5f * std::exp(-(u - u0) * aspect / 0.8f);
         if (u < u0 && u > 0.1f && b < 0.05f + 0.7f * (u0 - u)) rho += 1.0f * std::exp(-(u0 - u) * aspect / 0.3f);
         tau = rho;
-        if (d2 < 0.3f) glow = 2.0f;
+        if (d2 < 1.0f) glow = 2.0f;  // the core shines
       } else if (name == "shells") {
         // Three concentric spherical shells about the map's centre.
         const float a = (u - 0.5f) * aspect, rho = std::sqrt(a * a + v * v) / fit;

@@ -408,7 +408,8 @@ TEST_F(RenderScene, AxialMapsAndTheTruthRunThroughTheSamePipeline) {
 TEST_F(RenderScene, AxialDeformationsRunThroughThePipeline) {
   const std::string base =
       "bands = [\"B\", \"V\"]\n[axial]\nsynthetic = \"lopsided\"\nnx = 32\nnr = 16\nemission_scale = 1.0\n"
-      "[camera]\nposition = [4.0, 0.0, 1.0]\nlook_at = [0.0, 0.0, 1.0]\nwidth = 16\nheight = 16\n";
+      "[camera]\nkind = \"orthographic\"\nposition = [4.0, 0.0, 1.0]\nlook_at = [0.0, 0.0, 1.0]\northo_width = 2.4\n"
+      "width = 24\nheight = 24\n";
   const Scene plain = load_scene(write_text("plain.toml", base));
   const Scene deformed = load_scene(write_text(
       "deformed.toml", base + "[axial.colour_deform]\namplitude = 0.9\n[axial.shape_deform]\namplitude = 0.4\n"));
