@@ -541,6 +541,7 @@ void add_bench_command(CLI::App& app) {
   add_frame_benchmarks(cmd);  // app/bench_frames.cpp: animate, viewer
   add_sweep(cmd);
   add_spectral_bench(cmd);
+  add_reconstruct_bench(cmd);
 }
 
 }  // namespace nebula::app

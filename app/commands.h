@@ -17,5 +17,7 @@ void add_compare_command(CLI::App& app);
 void add_animate_command(CLI::App& app);
 void add_frame_benchmarks(CLI::App* bench);  // `nebula bench animate`, `nebula bench viewer`
 void add_sweep_command(CLI::App& app);
+void add_reconstruct_command(CLI::App& app);
+void add_reconstruct_bench(CLI::App* bench);  // `nebula bench reconstruct` (app/reconstruct_command.cpp)
 
 }  // namespace nebula::app

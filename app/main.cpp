@@ -65,6 +65,7 @@ int main(int argc, char** argv) {
   nebula::app::add_animate_command(app);
   nebula::app::add_compare_command(app);
   nebula::app::add_sweep_command(app);
+  nebula::app::add_reconstruct_command(app);
   nebula::app::add_tabulate_command(app);
   nebula::app::add_table_command(app);
   nebula::app::add_slab_command(app);

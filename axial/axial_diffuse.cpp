@@ -131,8 +131,6 @@ DiffuseField bake_axial_diffuse(const AxialMap& map, const std::vector<DiffuseBa
   DiffuseField f;
   f.degree = f3.degree;
   f.shift = 0;
-  f.response = f3.response;
-  f.response_tau_max = f3.response_tau_max;
   const float edge = f3.cells.voxel;
   f.cells.voxel = edge;
   f.cells.origin = {0.0f, 0.0f, 0.0f};
@@ -140,16 +138,19 @@ DiffuseField bake_axial_diffuse(const AxialMap& map, const std::vector<DiffuseBa
   f.cells.ny = std::max(1, int(std::ceil(map.radius() / edge - 1e-4f)));
   f.cells.nz = 1;
   const int n = f.n_coeffs();
-  f.coeffs.resize(f3.coeffs.size());
-  for (size_t b = 0; b < f3.coeffs.size(); ++b) {
-    if (f3.coeffs[b].empty()) continue;
-    f.coeffs[b].assign(f.cells.count() * size_t(n), 0.0f);
+  f.allocate(f3.n_bands());
+  f.response = f3.response;
+  f.response_tau_max = f3.response_tau_max;
+  for (size_t b = 0; b < f3.n_bands(); ++b) {
+    if (!f3.has_band(b)) continue;
+    const std::vector<float> c3 = f3.band_coeffs(b);
+    std::vector<float> c(f.cells.count() * size_t(n), 0.0f);
     tbb::parallel_for(0, f.cells.ny, [&](int cr) {
       for (int cx = 0; cx < f.cells.nx; ++cx)
-        ring_average(f3, f3.coeffs[b], cx, cr, edge, &f.coeffs[b][f.cells.index(cx, cr, 0) * size_t(n)]);
+        ring_average(f3, c3, cx, cr, edge, &c[f.cells.index(cx, cr, 0) * size_t(n)]);
     });
+    f.set_band_coeffs(b, c);
   }
-  f.pack();
   st.bake.field_bytes = f.bytes();
   st.bake.work_bytes += f3.bytes() + grid.tau_v.size() * sizeof(float);
   st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -85,9 +85,9 @@ void validate(const AxialRenderInputs& in) {
   if (in.deform.shape) check_noise(in.deform.shape_noise, true, "axial render: shape deformation");
   if (in.diffuse) {
     const DiffuseField& f = *in.diffuse;
-    if (f.cells.nz != 1 || f.cells.nx < 1 || f.cells.ny < 1 || !(f.cells.voxel > 0) || f.coeffs.size() != in.bands.size())
+    if (f.cells.nz != 1 || f.cells.nx < 1 || f.cells.ny < 1 || !(f.cells.voxel > 0) || f.n_bands() != in.bands.size())
       throw Error("axial render: the diffuse field is not an axial one for these bands (axial/axial_diffuse.h)");
-    if (f.packed.size() != f.cells.count() * size_t(f.n_coeffs()) * 4)
+    if (!f.has_harmonics())
       throw Error("axial render: the diffuse field is not packed");
   }
 }

@@ -153,11 +153,11 @@ TEST(AxialRendererGpu, DiffuseFieldMatchesTheCpu) {
     AxialDiffuseStats cpu_stats;
     const DiffuseField cpu_field = bake_axial_diffuse(s.map, bands, {star}, o, Backend::Cpu, &cpu_stats);
     const DiffuseField gpu_field = bake_axial_diffuse(s.map, bands, {star}, o, Backend::Cuda);
-    ASSERT_EQ(cpu_field.packed.size(), gpu_field.packed.size());
+    ASSERT_EQ(cpu_field.host_packed().size(), gpu_field.host_packed().size());
     double diff = 0, norm = 0;
-    for (size_t i = 0; i < cpu_field.packed.size(); ++i) {
-      diff += std::pow(double(cpu_field.packed[i]) - gpu_field.packed[i], 2);
-      norm += std::pow(double(cpu_field.packed[i]), 2);
+    for (size_t i = 0; i < cpu_field.host_packed().size(); ++i) {
+      diff += std::pow(double(cpu_field.host_packed()[i]) - gpu_field.host_packed()[i], 2);
+      norm += std::pow(double(cpu_field.host_packed()[i]), 2);
     }
     const double rel = std::sqrt(diff / norm);
     std::printf("%s: axial field CPU-GPU relative L2 difference %.3g (one 3D cell's noise %.3g)\n", name.c_str(), rel,

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/device_mirror.h"
 #include "core/vec3.h"
 
 namespace nebula {
@@ -46,6 +47,7 @@ std::vector<std::string> band_names(const std::vector<AnyBand>& bands) {
 // renderer marches (voxels of a grid, texels of an axial map).
 struct BakedStar : StarLight {
   const std::vector<float>* depth_v = nullptr;
+  DeviceMirror* depth_mirror = nullptr;  // the CUDA kernels' copy of *depth_v, kept by its owner; null: uploaded per render
 };
 
 }  // namespace nebula

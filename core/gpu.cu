@@ -2,6 +2,8 @@
 
 #include <string>
 
+#include "core/cuda_check.h"
+#include "core/device_mirror.h"
 #include "core/error.h"
 #include "core/gpu.h"
 
@@ -34,6 +36,12 @@ std::string gpu_description() {
 
 // Unused in a CUDA build (no *_none.cpp entry point is compiled), kept so the
 // declaration has one meaning in every build.
+void DeviceMirror::download(void* host, size_t bytes) const {
+  std::lock_guard<std::mutex> lock(mutex());
+  if (device_ == nullptr || bytes_ != bytes) throw Error("device mirror: no device copy of that size to download");
+  NEBULA_CUDA_CHECK(cudaMemcpy(host, device_, bytes, cudaMemcpyDeviceToHost));
+}
+
 void no_cuda_backend() { throw ParameterError("backend", "cuda: not available"); }
 
 }  // namespace nebula

@@ -1,3 +1,4 @@
+#include "core/device_mirror.h"
 #include "core/error.h"
 #include "core/gpu.h"
 
@@ -13,6 +14,10 @@ bool gpu_available(std::string* reason) {
 }
 
 std::string gpu_description() { return "none (built without CUDA)"; }
+
+void DeviceMirror::download(void*, size_t) const {
+  throw Error("device mirror: this build has no CUDA backend");
+}
 
 void no_cuda_backend() { throw ParameterError("backend", std::string("cuda: ") + kNoCuda); }
 

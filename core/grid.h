@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "core/device_mirror.h"
 #include "core/hd.h"
 #include "core/vec3.h"
 
@@ -32,6 +33,7 @@ struct DensityView {
 struct DensityGrid {
   GridShape shape;
   std::vector<float> tau_v;
+  mutable DeviceMirror device_tau_v;  // the CUDA kernels' copy of tau_v, uploaded once (core/device_mirror.h)
   DensityView view() const { return {shape, tau_v.data()}; }
 };
 

@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/device_mirror.h"
+
 namespace nebula {
 
 class HostPlacement {
@@ -19,6 +21,16 @@ class HostPlacement {
   const T* place(const std::vector<T>& v) {
     bytes_ += v.size() * sizeof(T);
     return v.data();
+  }
+  // The same for an array with a device mirror (unused on the host).
+  template <class T>
+  const T* place(const std::vector<T>& v, DeviceMirror&) {
+    return place(v);
+  }
+  // An array that may live on the device only: fetch() gives the host copy.
+  template <class Fetch>
+  auto place_mirrored(DeviceMirror&, size_t, Fetch&& fetch) {
+    return place(fetch());
   }
   // An array made while assembling (per-star views, say), kept alive here.
   template <class T>

@@ -27,8 +27,23 @@ void check_options(const DiffuseBakeOptions& o) {
   if (o.max_orders < 0) throw ParameterError("max_orders", "must be 0 (all) or positive");
 }
 
-// Voxels of the density grid inside field cell (i, j, k) along one axis.
-int inside(int cell, int shift, int n) { return std::min(n - (cell << shift), 1 << shift); }
+// The relative L2 noise of a band's l = 0 field from its two halves: the
+// even and odd photons' sums are independent estimates.
+double field_noise(const std::vector<unsigned long long>& l0, const std::vector<unsigned long long>& odd,
+                   const GridShape& cells, const GridShape& grid, int shift) {
+  double noise2 = 0, signal2 = 0;
+  for (int z = 0; z < cells.nz; ++z)
+    for (int y = 0; y < cells.ny; ++y)
+      for (int x = 0; x < cells.nx; ++x) {
+        const size_t cell = cells.index(x, y, z);
+        const double volume = diffuse_cell_volume(grid, shift, x, y, z);
+        const double all = double(static_cast<long long>(l0[cell]));
+        const double half = double(static_cast<long long>(odd[cell]));
+        noise2 += (all - 2 * half) * (all - 2 * half) / (volume * volume);
+        signal2 += all * all / (volume * volume);
+      }
+  return signal2 > 0 ? std::sqrt(noise2 / signal2) : 0.0;
+}
 
 }  // namespace
 
@@ -75,16 +90,15 @@ DiffuseField bake_diffuse(const DensityGrid& density, const std::vector<DiffuseB
   DiffuseField field;
   field.degree = o.degree;
   field.cells = diffuse_cells(density.shape, o.cells, &field.shift);
-  field.coeffs.assign(bands.size(), {});
-  field.response.assign(bands.size(), {});
-  field.response_tau_max.assign(bands.size(), 0.0f);
   DiffuseBakeStats st;
   st.noise.assign(bands.size(), -1.0);
   const MajorantGrid majorant = build_majorant_grid(density, o.majorant_block);
   const int n_coeffs = field.n_coeffs();
   const GridShape& cells = field.cells;
   const GridShape& grid = density.shape;
-  const double edge = cells.voxel, voxel3 = double(grid.voxel) * grid.voxel * grid.voxel;
+  // One pass per band that scatters light from a star.
+  std::vector<DiffusePassInputs> passes;
+  std::vector<double> units;
   for (size_t b = 0; b < bands.size(); ++b) {
     const DiffuseBand& band = bands[b];
     if (!(band.albedo > 0) || stars.empty()) continue;
@@ -108,8 +122,38 @@ DiffuseField bake_diffuse(const DensityGrid& density, const std::vector<DiffuseB
     in.seed = o.seed;
     in.roulette_start = o.roulette_start;
     in.max_orders = o.max_orders;
-    const DiffusePassResult pass =
-        backend == Backend::Cuda ? diffuse_pass_cuda(in, o.photons) : diffuse_pass_cpu(in, o.photons, progress);
+    passes.push_back(std::move(in));
+    // Sums of weight x (chord / edge) x Y, each weight in units of the total
+    // power / photons: L_k = sum x (power / photons) x edge / (volume inside the grid).
+    units.push_back(total / double(o.photons) * cells.voxel / kDiffuseFixedScale);
+  }
+  std::vector<DiffusePassResult> results;
+  const bool on_device = backend == Backend::Cuda && !passes.empty();
+  field.allocate(bands.size(), /*on_host=*/!on_device);
+  if (on_device) {
+    results = diffuse_passes_cuda(passes, units, o.photons, grid, &field);
+  } else {
+    std::vector<float>& packed = field.packed_for_writing();
+    for (size_t p = 0; p < passes.size(); ++p) {
+      DiffusePassResult pass = diffuse_pass_cpu(passes[p], o.photons, progress);
+      const size_t b = passes[p].band_index;
+      tbb::parallel_for(0, cells.nz, [&](int z) {
+        for (int y = 0; y < cells.ny; ++y)
+          for (int x = 0; x < cells.nx; ++x) {
+            const size_t cell = cells.index(x, y, z);
+            const double volume = diffuse_cell_volume(grid, field.shift, x, y, z);
+            for (int k = 0; k < n_coeffs; ++k) {
+              const size_t i = cell * size_t(n_coeffs) + size_t(k);
+              packed[i * 4 + b] = diffuse_coefficient(pass.sums[i], units[p], volume);
+            }
+          }
+      });
+      results.push_back(std::move(pass));
+    }
+  }
+  for (size_t p = 0; p < passes.size(); ++p) {
+    const DiffusePassResult& pass = results[p];
+    const size_t b = passes[p].band_index;
     st.seconds += pass.seconds;
     st.photons += o.photons;
     st.counters.collisions += pass.counters.collisions;
@@ -118,33 +162,17 @@ DiffuseField bake_diffuse(const DensityGrid& density, const std::vector<DiffuseB
     st.counters.capped += pass.counters.capped;
     st.work_bytes = std::max(st.work_bytes, (pass.sums.size() + pass.odd.size()) * sizeof(unsigned long long) +
                                                 pass.device_bytes);
-    // Sums of weight x (chord / edge) x Y, each weight in units of the total
-    // power / photons: L_k = sum x (power / photons) x edge / (volume inside the grid).
-    const double unit = total / double(o.photons) * edge / kDiffuseFixedScale;
-    std::vector<float>& c = field.coeffs[b];
-    c.assign(pass.sums.size(), 0.0f);
-    double noise2 = 0, signal2 = 0;
-    for (int z = 0; z < cells.nz; ++z)
-      for (int y = 0; y < cells.ny; ++y)
-        for (int x = 0; x < cells.nx; ++x) {
-          const size_t cell = cells.index(x, y, z);
-          const double volume = voxel3 * inside(x, field.shift, grid.nx) * inside(y, field.shift, grid.ny) *
-                                inside(z, field.shift, grid.nz);
-          for (int k = 0; k < n_coeffs; ++k) {
-            const size_t i = cell * size_t(n_coeffs) + size_t(k);
-            c[i] = static_cast<float>(double(static_cast<long long>(pass.sums[i])) * unit / volume);
-          }
-          // The even and odd photons' l = 0 parts are two independent halves.
-          const double all = double(static_cast<long long>(pass.sums[cell * size_t(n_coeffs)]));
-          const double odd = double(static_cast<long long>(pass.odd[cell]));
-          noise2 += (all - 2 * odd) * (all - 2 * odd) / (volume * volume);
-          signal2 += all * all / (volume * volume);
-        }
-    st.noise[b] = signal2 > 0 ? std::sqrt(noise2 / signal2) : 0.0;
-    field.response[b] = delta_m_response(*band.table, o.degree);
-    field.response_tau_max[b] = static_cast<float>(band.table->tau_max());
+    std::vector<unsigned long long> l0;
+    const std::vector<unsigned long long>* l0_sums = &pass.sums;
+    if (pass.sums.size() != cells.count()) {  // all harmonics (CPU): take k = 0
+      l0.resize(cells.count());
+      for (size_t c = 0; c < l0.size(); ++c) l0[c] = pass.sums[c * size_t(n_coeffs)];
+      l0_sums = &l0;
+    }
+    st.noise[b] = field_noise(*l0_sums, pass.odd, cells, grid, field.shift);
+    field.response[b] = delta_m_response(*bands[b].table, o.degree);
+    field.response_tau_max[b] = static_cast<float>(bands[b].table->tau_max());
   }
-  field.pack();
   st.field_bytes = field.bytes();
   if (stats) *stats = st;
   return field;

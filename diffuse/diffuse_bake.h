@@ -73,13 +73,32 @@ struct DiffusePassResult {
   size_t device_bytes = 0;
 };
 DiffusePassResult diffuse_pass_cpu(const DiffusePassInputs& in, uint64_t photons, Progress* progress);
-DiffusePassResult diffuse_pass_cuda(const DiffusePassInputs& in, uint64_t photons);
+
+// A band's sums become its harmonics: sum x unit / (the grid's volume inside the cell).
+NEBULA_HD double diffuse_cell_volume(const GridShape& grid, int shift, int x, int y, int z) {
+  const int edge = 1 << shift;
+  const int ix = grid.nx - (x << shift), iy = grid.ny - (y << shift), iz = grid.nz - (z << shift);
+  return double(grid.voxel) * grid.voxel * grid.voxel * (ix < edge ? ix : edge) * (iy < edge ? iy : edge) *
+         (iz < edge ? iz : edge);
+}
+NEBULA_HD float diffuse_coefficient(unsigned long long sum, double unit, double volume) {
+  return static_cast<float>(double(static_cast<long long>(sum)) * unit / volume);
+}
+
+// Every band's pass on the GPU with the grid uploaded once; the harmonics are
+// made from the sums there and stay there, in field->device_packed (the
+// field has no host copy until host_packed() fetches one). Per pass (the order of
+// `passes`): its l = 0 sums and odd sums (`sums` holds only k = 0) for the
+// noise, counters and time.
+std::vector<DiffusePassResult> diffuse_passes_cuda(const std::vector<DiffusePassInputs>& passes,
+                                                   const std::vector<double>& units, uint64_t photons,
+                                                   const GridShape& grid, DiffuseField* field);
 
 // The pass's kernel scene, assembled once for both backends (core/placement.h).
 template <class Place>
 DiffusePhotonScene assemble_photon_scene(const DiffusePassInputs& in, Place& place) {
   DiffusePhotonScene s;
-  s.medium.density = {in.density->shape, place.place(in.density->tau_v)};
+  s.medium.density = {in.density->shape, place.place(in.density->tau_v, in.density->device_tau_v)};
   s.medium.majorant = in.majorant->view();
   s.medium.majorant.max_tau_v = place.place(in.majorant->max_tau_v);
   s.medium.majorant.min_tau_v = place.place(in.majorant->min_tau_v);

@@ -3,6 +3,9 @@
 
 namespace nebula {
 
-DiffusePassResult diffuse_pass_cuda(const DiffusePassInputs&, uint64_t) { no_cuda_backend(); }
+std::vector<DiffusePassResult> diffuse_passes_cuda(const std::vector<DiffusePassInputs>&, const std::vector<double>&,
+                                                   uint64_t, const GridShape&, DiffuseField*) {
+  no_cuda_backend();
+}
 
 }  // namespace nebula

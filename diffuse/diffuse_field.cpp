@@ -2,36 +2,89 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 
 #include "core/error.h"
 #include "core/math.h"
 
 namespace nebula {
 
-void DiffuseField::pack() {
-  const size_t n = size_t(n_coeffs()), count = cells.count();
-  packed.assign(count * n * 4, 0.0f);
-  for (size_t b = 0; b < coeffs.size() && b < size_t(kMaxBands); ++b) {
-    if (coeffs[b].empty()) continue;
-    if (coeffs[b].size() != count * n) throw Error("diffuse field: band " + std::to_string(b) + " has the wrong size");
-    for (size_t i = 0; i < count * n; ++i) packed[i * 4 + b] = coeffs[b][i];
+DiffuseField::DiffuseField(const DiffuseField& other)
+    : cells(other.cells), shift(other.shift), degree(other.degree), response(other.response),
+      response_tau_max(other.response_tau_max), packed_(other.packed_) {
+  device_packed.share(other.device_packed);
+}
+
+DiffuseField& DiffuseField::operator=(const DiffuseField& other) {
+  if (this != &other) {
+    DiffuseField copy(other);
+    *this = std::move(copy);
   }
+  return *this;
+}
+
+bool DiffuseField::has_harmonics() const {
+  return packed_.size() == packed_size() || device_packed.holds(packed_size() * sizeof(float));
+}
+
+void DiffuseField::allocate(size_t bands, bool on_host) {
+  if (bands > size_t(kMaxBands)) throw Error("diffuse field: at most " + std::to_string(kMaxBands) + " bands");
+  packed_.clear();
+  if (on_host) packed_.assign(packed_size(), 0.0f);
+  response.assign(bands, {});
+  response_tau_max.assign(bands, 0.0f);
+  device_packed.reset();
+}
+
+const std::vector<float>& DiffuseField::host_packed() const {
+  // Fetched once, under a lock: two threads may render from one field.
+  static std::mutex fetching;
+  std::lock_guard<std::mutex> lock(fetching);
+  if (packed_.size() != packed_size()) {
+    std::vector<float> host(packed_size());
+    device_packed.download(host.data(), host.size() * sizeof(float));
+    packed_ = std::move(host);
+  }
+  return packed_;
+}
+
+std::vector<float>& DiffuseField::packed_for_writing() {
+  host_packed();
+  device_packed.reset();
+  return packed_;
+}
+
+std::vector<float> DiffuseField::band_coeffs(size_t b) const {
+  if (b >= size_t(kMaxBands)) throw Error("diffuse field: no band " + std::to_string(b));
+  const std::vector<float>& packed = host_packed();
+  const size_t n = packed.size() / 4;
+  std::vector<float> out(n);
+  for (size_t i = 0; i < n; ++i) out[i] = packed[i * 4 + b];
+  return out;
+}
+
+void DiffuseField::set_band_coeffs(size_t b, const std::vector<float>& coeffs) {
+  std::vector<float>& packed = packed_for_writing();
+  const size_t n = packed.size() / 4;
+  if (b >= size_t(kMaxBands) || coeffs.size() != n)
+    throw Error("diffuse field: band " + std::to_string(b) + " has the wrong size");
+  for (size_t i = 0; i < n; ++i) packed[i * 4 + b] = coeffs[i];
 }
 
 size_t DiffuseField::bytes() const {
-  size_t floats = packed.size() + response_tau_max.size();
+  size_t floats = packed_size() + response_tau_max.size();
   for (const auto& r : response) floats += r.size();
   return floats * sizeof(float);
 }
 
-DiffuseView DiffuseField::view() const {
+DiffuseView DiffuseField::view(bool without_harmonics) const {
   DiffuseView v;
   v.cells = cells;
   v.shift = shift;
   v.degree = degree;
-  v.packed = packed.data();
-  for (size_t b = 0; b < coeffs.size() && b < size_t(kMaxBands); ++b) {
-    if (coeffs[b].empty()) continue;
+  v.packed = without_harmonics ? nullptr : host_packed().data();
+  for (size_t b = 0; b < response.size() && b < size_t(kMaxBands); ++b) {
+    if (response[b].empty()) continue;
     v.has[b] = true;
     v.response[b] = response[b].data();
     v.rows[b] = static_cast<int>(response[b].size() / size_t(diffuse_response_stride(degree)));

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "core/bands.h"
+#include "core/device_mirror.h"
 #include "core/grid.h"
 #include "core/hd.h"
 #include "diffuse/spherical_harmonics.h"
@@ -164,21 +165,47 @@ decltype(auto) dispatch_diffuse_degree(int degree, F&& f) {
   return f(std::integral_constant<int, 4>{});
 }
 
-// The owning field.
+// The owning field. Its harmonics live in `packed`, the kernels' layout; a
+// band has a field when it has a response. A CUDA bake leaves them on the
+// device only (device_packed, where the CUDA marchers read them): host code
+// reads them through host_packed(), which downloads them the first time.
 struct DiffuseField {
   GridShape cells;
   int shift = 0;   // a cell spans 2^shift voxels per axis
   int degree = 3;
-  std::vector<std::vector<float>> coeffs;    // [band]: [cell * n_coeffs + k]; empty where the band has no field
-  std::vector<float> packed;                 // the bands interleaved for kernels (pack())
-  std::vector<std::vector<float>> response;  // [band]: per table row, p*_0..p*_degree, the peak, padding (delta_m_response)
+  std::vector<std::vector<float>> response;  // [band]: per table row, p*_0..p*_degree, the peak, padding (delta_m_response); empty: no field
   std::vector<float> response_tau_max;       // [band]
+  // The device copy of the harmonics (core/device_mirror.h); changing them resets it.
+  mutable DeviceMirror device_packed;
+
+  DiffuseField() = default;
+  DiffuseField(const DiffuseField& other);  // shares the device copy: the harmonics are the same
+  DiffuseField& operator=(const DiffuseField& other);
+  DiffuseField(DiffuseField&&) = default;
+  DiffuseField& operator=(DiffuseField&&) = default;
 
   int n_coeffs() const { return sh_count(degree); }
-  // Builds `packed` from `coeffs`: [(cell * n_coeffs + k) * 4 + band], 0 for bands without a field.
-  void pack();
-  size_t bytes() const;       // what a kernel reads: packed and the responses
-  DiffuseView view() const;   // host pointers (pack() first)
+  size_t n_bands() const { return response.size(); }
+  bool has_band(size_t b) const { return b < response.size() && !response[b].empty(); }
+  size_t packed_size() const { return cells.count() * size_t(n_coeffs()) * 4; }
+  // Whether the harmonics are there, on the host or the device.
+  bool has_harmonics() const;
+  // Sizes the arrays for `bands` bands, harmonics all zero and no band with a
+  // field yet; on_host = false: the harmonics will be made on the device.
+  void allocate(size_t bands, bool on_host = true);
+  // [(cell * n_coeffs + k) * 4 + band], 0 for bands without a field.
+  const std::vector<float>& host_packed() const;
+  // Band b's harmonics, [cell * n_coeffs + k] (copied out of / into the packed array).
+  std::vector<float> band_coeffs(size_t b) const;
+  void set_band_coeffs(size_t b, const std::vector<float>& coeffs);
+  // The host array, for a producer on the host to write (resets the device copy).
+  std::vector<float>& packed_for_writing();
+  size_t bytes() const;       // what a kernel reads: the harmonics and the responses
+  // Host pointers; without_harmonics: all but `packed` (for a placement to fill).
+  DiffuseView view(bool without_harmonics = false) const;
+
+ private:
+  mutable std::vector<float> packed_;  // empty while only the device holds the harmonics
 };
 
 // p_0 .. p_n of every row of `table` (row-major, n + 1 per row): the table's

@@ -73,11 +73,12 @@ void check_truncated_series(const ScatteringTable& t) {
   const float E = 2.5f;
   float y[kMaxShCoeffs];
   sh_basis(degree, d0, y);
-  f.coeffs = {std::vector<float>(y, y + sh_count(degree))};
-  for (float& v : f.coeffs[0]) v *= E;
+  f.allocate(1);
+  std::vector<float> c(y, y + sh_count(degree));
+  for (float& v : c) v *= E;
+  f.set_band_coeffs(0, c);
   f.response = {delta_m_response(t, degree)};
   f.response_tau_max = {float(t.tau_max())};
-  f.pack();
   const DiffuseView v = f.view();
   ASSERT_TRUE(v.has[0]);
   ASSERT_FALSE(v.has[1]);

@@ -10,6 +10,7 @@
 
 #include "core/backend.h"
 #include "core/dda.h"
+#include "core/device_mirror.h"
 #include "core/grid.h"
 #include "core/hd.h"
 #include "core/math.h"
@@ -40,6 +41,7 @@ NEBULA_HD float star_irradiance(float power, float r, float voxel, float tau_b) 
 
 struct BakeResult {
   std::vector<std::vector<float>> tau_v;  // [star][voxel], V-band depth to the voxel sphere
+  std::vector<DeviceMirror> device_tau_v; // [star]: the CUDA marchers' copies (BakedStar::depth_mirror), when kept
   double seconds = 0;                     // compute time (CUDA events on the GPU)
 };
 

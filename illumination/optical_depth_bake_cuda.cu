@@ -2,6 +2,8 @@
 // NEBULA_HD star_to_voxel_depth.
 #include <cuda_runtime.h>
 
+#include <memory>
+
 #include "core/cuda_check.h"
 #include "core/cuda_timer.h"
 #include "core/device_array.h"
@@ -23,21 +25,30 @@ __global__ void bake_kernel(DensityView grid, Vec3 star, float* depth) {
 
 BakeResult bake_star_depths_cuda(const DensityGrid& grid, const std::vector<Vec3>& stars) {
   const GridShape& g = grid.shape;
-  const DeviceArray<float> tau(grid.tau_v);
-  DeviceArray<float> depth(g.count() * stars.size());
-  const DensityView view{g, tau.get()};
+  // The grid's device copy, uploaded once for this bake, the renders and the diffuse bake.
+  const DeviceMirror::Copy tau = grid.device_tau_v.get_or_upload(grid.tau_v.size() * sizeof(float), [&] {
+    auto array = std::make_shared<DeviceArray<float>>(grid.tau_v);
+    return DeviceMirror::Copy{array, array->get()};
+  });
+  const DensityView view{g, static_cast<const float*>(tau.device)};
+  std::vector<std::shared_ptr<DeviceArray<float>>> depth;
+  for (size_t s = 0; s < stars.size(); ++s) depth.push_back(std::make_shared<DeviceArray<float>>(g.count()));
   const dim3 block(32, 8), blocks((g.nx + 31) / 32, (g.ny + 7) / 8, g.nz);
   BakeResult out;
   CudaEventTimer timer;
   for (size_t s = 0; s < stars.size(); ++s) {
-    bake_kernel<<<blocks, block>>>(view, stars[s], depth.get() + s * g.count());
+    bake_kernel<<<blocks, block>>>(view, stars[s], depth[s]->get());
     NEBULA_CUDA_CHECK(cudaGetLastError());
   }
   out.seconds = timer.seconds();
+  // The host copies, and the device ones kept for the marchers (BakedStar::depth_mirror).
   out.tau_v.assign(stars.size(), std::vector<float>(g.count()));
-  for (size_t s = 0; s < stars.size(); ++s)
-    NEBULA_CUDA_CHECK(cudaMemcpy(out.tau_v[s].data(), depth.get() + s * g.count(), g.count() * sizeof(float),
-                                 cudaMemcpyDeviceToHost));
+  out.device_tau_v.resize(stars.size());
+  for (size_t s = 0; s < stars.size(); ++s) {
+    depth[s]->download(out.tau_v[s].data());
+    float* device = depth[s]->get();
+    out.device_tau_v[s].set({std::move(depth[s]), device}, g.count() * sizeof(float));
+  }
   return out;
 }
 

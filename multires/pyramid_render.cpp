@@ -88,7 +88,12 @@ PyramidResult render_pyramid(const RenderInputs& in, const PreparedPyramid& prep
     out.report.push_back(r);
   }
   const auto t0 = std::chrono::steady_clock::now();
-  out.image = combine_pyramid(out.levels);
+  if (out.levels.size() == 1 && !keep_levels) {
+    out.image = std::move(out.levels[0]);  // one level: the image itself (a frame's copy saved)
+    out.levels.clear();
+  } else {
+    out.image = combine_pyramid(out.levels);
+  }
   out.combine_seconds = seconds_since(t0);
   return out;
 }

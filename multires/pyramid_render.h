@@ -27,7 +27,7 @@ struct PyramidLevelReport {
 
 struct PyramidResult {
   Image image;                // I_0 + the up-sampled clipped differences
-  std::vector<Image> levels;  // I_0 .. I_n (I_j at 1/2^j resolution); on the GPU only when asked for
+  std::vector<Image> levels;  // I_0 .. I_n (I_j at 1/2^j resolution); on the GPU, and with no coarser levels, only when asked for
   std::vector<PyramidLevelReport> report;  // one per level, 0 first
   double combine_seconds = 0;              // host clock on the CPU, CUDA events on the GPU
 };

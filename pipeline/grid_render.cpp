@@ -140,8 +140,11 @@ PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o, PreparedGr
     if (!scatters[b]) band.albedo = 0.0f;
     in.bands.push_back(RenderBand{band, p.tables.per_band[b].get(), scene.emission.empty() ? nullptr : &scene.emission[b]});
   }
-  if (any)
-    for (size_t k = 0; k < positions.size(); ++k) in.stars.push_back(BakedStar{p.bands.stars[k], &p.bake.tau_v[k]});
+  if (any) {
+    p.bake.device_tau_v.resize(p.bake.tau_v.size());  // kept with the bake: uploaded once for every frame
+    for (size_t k = 0; k < positions.size(); ++k)
+      in.stars.push_back(BakedStar{p.bands.stars[k], &p.bake.tau_v[k], &p.bake.device_tau_v[k]});
+  }
   in.mode = MarchMode{o.smooth_step, true};
   if (diffuse) in.diffuse = &p.diffuse;
   p.pyramid = prepare_pyramid(in, scene.multiple_scattering == MultipleScattering::Pyramid ? scene.pyramid_levels : 0,
@@ -162,11 +165,11 @@ RenderOutput render_prepared(const PreparedGrid& p, const CameraSettings& settin
   if (p.options.progress && p.options.backend == Backend::Cpu)
     bar = std::make_unique<Progress>("render", uint64_t(in.camera.height));
   in.progress = bar.get();
-  const PyramidResult pyramid = render_pyramid(in, p.pyramid, p.options.backend);
+  PyramidResult pyramid = render_pyramid(in, p.pyramid, p.options.backend);
   if (bar) bar->finish();
 
   RenderOutput out;
-  out.image = box_downsample(pyramid.image, k);
+  out.image = box_downsample(std::move(pyramid.image), k);
   out.report = p.report;
   out.report.camera = to_string(settings.projection);
   out.report.width = camera.width;

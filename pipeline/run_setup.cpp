@@ -166,7 +166,7 @@ CameraSettings supersampled_camera(const CameraSettings& camera, int samples_per
   return fine;
 }
 
-Image box_downsample(const Image& fine, int k) {
+Image box_downsample(Image fine, int k) {
   if (k == 1) return fine;
   Image out(fine.width / k, fine.height / k, fine.bands);
   const double weight = 1.0 / (double(k) * k);

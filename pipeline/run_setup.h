@@ -78,7 +78,7 @@ std::string multiple_scattering_text(const RunReport& r);
 // of its k^2 rays. supersampled_camera is that finer camera (k = 1: the same).
 CameraSettings supersampled_camera(const CameraSettings& camera, int samples_per_pixel);
 // The mean of each k x k block of `fine` (k * width x k * height).
-Image box_downsample(const Image& fine, int k);
+Image box_downsample(Image fine, int k);  // k = 1: `fine` itself, moved (no copy)
 // A progress bar over the bake's photons on the CPU (null otherwise).
 std::unique_ptr<Progress> diffuse_progress(const std::vector<DiffuseBand>& bands, const DiffuseBakeOptions& options,
                                            const RenderOptions& o);

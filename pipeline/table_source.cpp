@@ -88,7 +88,7 @@ ScatteringTable cached_table(const TabulateParams& p, Backend backend, bool prog
     // An entry is trusted only once read, checked and found to be the table asked for.
     std::string problem;
     try {
-      ScatteringTable cached = read_table(path.string());
+      ScatteringTable cached = read_own_table(path.string());
       problem = mismatch(cached, p);
       if (problem.empty()) {
         if (origin) *origin = TableOrigin::Cache;

@@ -20,7 +20,8 @@ const StarView* place_star_views(const std::vector<BakedStar>& stars, int n_band
   for (size_t k = 0; k < stars.size(); ++k) {
     views[k].position = stars[k].position;
     for (int b = 0; b < n_bands; ++b) views[k].power[b] = stars[k].power[size_t(b)];
-    views[k].depth_v = place.place(*stars[k].depth_v);
+    views[k].depth_v = stars[k].depth_mirror ? place.place(*stars[k].depth_v, *stars[k].depth_mirror)
+                                             : place.place(*stars[k].depth_v);
   }
   return place.keep(std::move(views));
 }
@@ -28,10 +29,11 @@ const StarView* place_star_views(const std::vector<BakedStar>& stars, int n_band
 // A kernel view of a diffuse field with its arrays placed.
 template <class Place>
 DiffuseView place_diffuse(const DiffuseField& field, Place& place) {
-  DiffuseView v = field.view();
-  v.packed = place.place(field.packed);
-  for (size_t b = 0; b < field.coeffs.size() && b < size_t(kMaxBands); ++b)
-    if (!field.coeffs[b].empty()) v.response[b] = place.place(field.response[b]);
+  DiffuseView v = field.view(/*without_harmonics=*/true);
+  v.packed = place.place_mirrored(field.device_packed, field.packed_size(),
+                                  [&]() -> const std::vector<float>& { return field.host_packed(); });
+  for (size_t b = 0; b < field.n_bands() && b < size_t(kMaxBands); ++b)
+    if (field.has_band(b)) v.response[b] = place.place(field.response[b]);
   return v;
 }
 
@@ -40,7 +42,7 @@ template <class Place>
 MarchScene assemble_march_scene(const RenderInputs& in, Place& place) {
   validate(in);
   MarchScene scene{};
-  scene.density = {in.density->shape, place.place(in.density->tau_v)};
+  scene.density = {in.density->shape, place.place(in.density->tau_v, in.density->device_tau_v)};
   scene.n_bands = static_cast<int>(in.bands.size());
   scene.min_transmittance = in.min_transmittance;
   scene.footprint = in.camera.footprint();

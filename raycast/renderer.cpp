@@ -34,15 +34,11 @@ void validate(const RenderInputs& in) {
   if (const DiffuseField* f = in.diffuse) {
     const GridShape& g = in.density->shape;
     const int edge = 1 << f->shift;
-    if (f->coeffs.size() != in.bands.size() || f->cells.nx != (g.nx + edge - 1) / edge ||
+    if (f->n_bands() != in.bands.size() || f->cells.nx != (g.nx + edge - 1) / edge ||
         f->cells.ny != (g.ny + edge - 1) / edge || f->cells.nz != (g.nz + edge - 1) / edge)
       throw Error("render: the diffuse field was baked for another grid or other bands");
-    if (f->packed.size() != f->cells.count() * size_t(f->n_coeffs()) * 4)
-      throw Error("render: the diffuse field is not packed (DiffuseField::pack)");
-    for (size_t b = 0; b < in.bands.size(); ++b)
-      if (!f->coeffs[b].empty() &&
-          (f->coeffs[b].size() != f->cells.count() * size_t(f->n_coeffs()) || f->response[b].empty()))
-        throw Error("render: the diffuse field of band " + in.bands[b].name + " is malformed");
+    if (!f->has_harmonics())
+      throw Error("render: the diffuse field's harmonics have the wrong size");
   }
 }
 

@@ -920,6 +920,7 @@ Scene Parser::build(toml::table& root, const Scene* reuse_grids) {
   }
   if (!axial && reuse_grids && !reuse_grids->grid_source.empty() && reuse_grids->grid_source == scene.grid_source) {
     scene.density = reuse_grids->density;
+    scene.density.device_tau_v.share(reuse_grids->density.device_tau_v);  // the same grid: its GPU copy too
     scene.emission = reuse_grids->emission;
   } else if (!axial) {
     load_grids(density, emission, scene);  // the expensive part, last

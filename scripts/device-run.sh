@@ -22,4 +22,6 @@ nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm,memory.total 
 "$B/bin/nebula" bench axial --backend cuda 2>&1 | tee "$OUT/bench_axial.log"
 "$B/bin/nebula" bench axial --backend cuda --emission-only 2>&1 | tee "$OUT/bench_axial_emission_only.log"
 "$B/bin/nebula" bench axial --backend cuda --maps full --no-step-aside 2>&1 | tee "$OUT/bench_axial_full_no_step_aside.log"
+"$B/bin/nebula" bench reconstruct --backend cuda --map-size 1024 2>&1 | tee "$OUT/bench_reconstruct.log"
+"$B/bin/nebula" bench reconstruct --backend cuda --map-size 1024 --maps lopsided --noise 0.02 2>&1 | tee "$OUT/bench_reconstruct_noise.log"
 "$B/bin/nebula" render --demo --backend cuda --force -o "$OUT/demo.h5" 2>&1 | tee "$OUT/render_demo.log"

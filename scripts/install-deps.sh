@@ -11,6 +11,8 @@ packages=(
   python3-dev pybind11-dev python3-pytest
   # issue 13: animate's MP4 (H.264), the viewer (GLFW, Dear ImGui, OpenGL) and its tests under Xvfb with Mesa
   ffmpeg libglfw3-dev libimgui-dev libgl-dev xvfb xauth libgl1-mesa-dri
+  # issue 15: reconstruction of axial maps (non-negative least squares on Eigen, the absorbing fit with Ceres)
+  libeigen3-dev libceres-dev
 )
 
 missing=()
@@ -29,4 +31,4 @@ fi
 echo "install-deps: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 "${sudo_cmd[@]}" apt-get update -qq
-"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+"${sudo_cmd[@]}" apt-get -o DPkg::Lock::Timeout=600 install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

@@ -393,4 +393,6 @@ ScatteringTable read_table(const std::string& path) {
   return read_table_here(path);
 }
 
+ScatteringTable read_own_table(const std::string& path) { return read_table_here(path); }
+
 }  // namespace nebula

@@ -18,5 +18,10 @@ void write_table(const ScatteringTable& table, const std::string& path, bool ove
 // Reads and checks a table file; refuses missing, foreign, malformed or
 // inconsistent files.
 ScatteringTable read_table(const std::string& path);
+// A table this program wrote itself (the table cache, written aside and
+// renamed): read in the process, without read_table's child first. A child
+// forked from a process holding a GPU context and large bakes costs tens of
+// milliseconds, once per table of a sweep.
+ScatteringTable read_own_table(const std::string& path);
 
 }  // namespace nebula

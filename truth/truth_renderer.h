@@ -68,7 +68,7 @@ PathScene assemble_path_scene(const TruthInputs& in, const MajorantGrid& majoran
     for (int b = 0; b < kMaxBands; ++b) stars[k].power[b] = b < int(in.bands.size()) ? in.stars[k].power[size_t(b)] : 0.0f;
   }
   PathScene s;
-  s.density = {in.density->shape, place.place(in.density->tau_v)};
+  s.density = {in.density->shape, place.place(in.density->tau_v, in.density->device_tau_v)};
   s.majorant = majorant.view();
   s.majorant.max_tau_v = place.place(majorant.max_tau_v);
   s.majorant.min_tau_v = place.place(majorant.min_tau_v);
