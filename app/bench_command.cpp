@@ -251,6 +251,101 @@ void add_truth(CLI::App* bench) {
   });
 }
 
+// The thesis' Tables 5.1-5.5 (Khalass 2021, RTX 2080 Ti, emission-absorption,
+// 1024^2 map, 2048^2 image), as /work/shared/REFERENCES.md quotes them: per
+// synthetic map its thesis case and the speed-ups over the naive march the
+// thesis reports, without and with deformations ("" where it gives none).
+struct ThesisCell {
+  const char* map;
+  AxialSkip mode;
+  const char* plain;
+  const char* deformed;
+  double plain_ratio, deformed_ratio;  // 0: no number to compare with
+};
+const ThesisCell kThesisCells[] = {
+    {"bipolar", AxialSkip::Naive, "34.9 ms", "", 0, 0},
+    {"bipolar", AxialSkip::ThesisOmegaMax, "15.3x", "", 15.3, 0},
+    {"bipolar", AxialSkip::ThesisOmegaLarge, "8.4x", "", 8.4, 0},
+    {"bipolar", AxialSkip::ThesisOmegaMulti, "34.9x (1.0 ms)", "35.1x", 34.9, 35.1},
+    {"lopsided", AxialSkip::ThesisOmegaMulti, "16.4x", "22.9x", 16.4, 22.9},
+    {"shells", AxialSkip::ThesisOmegaMulti, "5.3x", "6.3x", 5.3, 6.3},
+    {"empty", AxialSkip::ThesisOmegaMax, "< 1 ms (> 35x)", "", 0, 0},
+    {"empty", AxialSkip::ThesisOmegaLarge, "9.8x", "", 9.8, 0},
+    {"empty", AxialSkip::ThesisOmegaMulti, "< 1 ms (> 35x)", "", 0, 0},
+    {"full", AxialSkip::Empty, "0.7x", "", 0.7, 0},
+    {"full", AxialSkip::ThesisOmegaMax, "0.7x", "", 0.7, 0},
+    {"full", AxialSkip::ThesisOmegaLarge, "0.7x", "", 0.7, 0},
+    {"full", AxialSkip::ThesisOmegaMulti, "0.7x", "", 0.7, 0},
+};
+
+const char* thesis_case(const std::string& map) {
+  if (map == "bipolar") return "thin, like M2-9";
+  if (map == "lopsided") return "like the Calabash nebula";
+  if (map == "shells") return "round, like NGC 6826";
+  if (map == "empty") return "the empty map";
+  return "the full map";
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// Tables 5.1-5.5 beside ours: per map, per mode, the median over the
+// inclinations of our speed-up (and time), without and with deformations.
+void print_thesis_tables(const std::vector<AxialBenchRow>& rows, const std::vector<std::string>& maps,
+                         const std::vector<AxialSkip>& modes) {
+  std::printf("\nKhalass 2021 Tables 5.1-5.5 beside ours: speed-up over the naive march (median over the inclinations; "
+              "time in brackets). Thesis: RTX 2080 Ti, emission-absorption, 1024^2 map, 2048^2 image, its deformations; "
+              "ours: this run. ours/thesis: our speed-up over the thesis' (goal: within 1/1.5 to 1.5).\n");
+  for (const std::string& map : maps) {
+    double empty = 0;
+    for (const AxialBenchRow& r : rows)
+      if (r.map == map) empty = r.empty_fraction;
+    std::printf("\n%s (%s): %.1f%% of its texels empty\n\n", map.c_str(), thesis_case(map), 100.0 * empty);
+    std::printf("| mode | thesis, no deformations | thesis, with deformations | ours, no deformations | "
+                "ours, with deformations | ours/thesis, no def. | ours/thesis, with def. |\n"
+                "|---|---|---|---|---|---|---|\n");
+    for (AxialSkip mode : modes) {
+      const ThesisCell* cell = nullptr;
+      for (const ThesisCell& c : kThesisCells)
+        if (map == c.map && mode == c.mode) cell = &c;
+      std::string ours[2], versus[2];
+      for (int d = 0; d < 2; ++d) {
+        std::vector<double> speedups, ms;
+        for (const AxialBenchRow& r : rows)
+          if (r.map == map && r.mode == to_string(mode) && r.deformed == (d == 1)) {
+            speedups.push_back(r.speedup);
+            ms.push_back(r.median_ms);
+          }
+        if (speedups.empty()) {
+          ours[d] = "-";
+          continue;
+        }
+        char text[96];
+        if (mode == AxialSkip::Naive)
+          std::snprintf(text, sizeof text, "%.3g ms", median(ms));
+        else
+          std::snprintf(text, sizeof text, "%.3gx (%.3g ms)", median(speedups), median(ms));
+        ours[d] = text;
+        const double thesis = cell ? (d == 0 ? cell->plain_ratio : cell->deformed_ratio) : 0;
+        if (thesis > 0) {
+          std::snprintf(text, sizeof text, "%.2f", median(speedups) / thesis);
+          versus[d] = text;
+        }
+      }
+      const char* plain = cell && *cell->plain ? cell->plain : "-";
+      const char* deformed = cell && *cell->deformed ? cell->deformed : "-";
+      std::printf("| %s | %s | %s | %s | %s | %s | %s |\n", to_string(mode), plain, deformed, ours[0].c_str(),
+                  ours[1].c_str(), versus[0].empty() ? "-" : versus[0].c_str(),
+                  versus[1].empty() ? "-" : versus[1].c_str());
+    }
+  }
+  std::fflush(stdout);
+}
+
 void add_axial(CLI::App* bench) {
   struct Options : Common {
     std::vector<std::string> maps{"bipolar", "lopsided", "shells", "empty", "full"}, modes;
@@ -258,17 +353,18 @@ void add_axial(CLI::App* bench) {
     int map_size = 1024, image = 2048;
     float step = 0.5f;
     bool emission_only = false, step_aside = true, diffuse = false;
+    std::string deform = "both", noise = "fbm", write_maps;
   };
   auto o = std::make_shared<Options>();
   CLI::App* cmd = add_bench(bench, "axial",
-                            "axial maps: every skip mode on every synthetic map, 0 to 90 degrees "
-                            "(Khalass 2021, Tables 5.1-5.5)",
+                            "axial maps: every skip mode on every synthetic map, 0 to 90 degrees, without and with "
+                            "deformations (Khalass 2021, Tables 5.1-5.5, printed beside ours at the end)",
                             *o);
   cmd->add_option("--map-size", o->map_size, "texels along the axis and radially")
       ->capture_default_str()->check(CLI::Range(2, 16384));
   cmd->add_option("--image", o->image, "image width and height, pixels (the CPU renders 1/8 of it per side)")
       ->capture_default_str()->check(CLI::Range(1, 16384));
-  cmd->add_option("--step", o->step, "march step, texels")->capture_default_str()->check(CLI::Range(1e-3, 100.0));
+  cmd->add_option("--step", o->step, "march step, texels (the thesis: 1)")->capture_default_str()->check(CLI::Range(1e-3, 100.0));
   cmd->add_option("--maps", o->maps, "comma-separated synthetic maps")
       ->delimiter(',')->capture_default_str()->check(CLI::IsMember(synthetic_axial_map_names()));
   cmd->add_option("--inclinations", o->inclinations, "comma-separated whole degrees from the axis")
@@ -280,28 +376,76 @@ void add_axial(CLI::App* bench) {
                 "with the star, the map's diffuse field (light scattered between cells; its bake timed once per map)");
   cmd->add_flag("!--no-step-aside", o->step_aside,
                 "run the skip code even on maps without empty texels (its overhead on the full map)");
+  cmd->add_option("--deform", o->deform,
+                  "off, on, both (off, then on), colour or shape (on, that kind only): the colour and shape "
+                  "deformations (colour amplitude 0.5, pull up to 0.2, frequency 4 per map length, 4 octaves)")
+      ->capture_default_str()->check(CLI::IsMember({"off", "on", "both", "colour", "shape"}));
+  cmd->add_option("--noise", o->noise, "the deformations' noise: simplex, fbm, turbulence or cellular")
+      ->capture_default_str()->check(CLI::IsMember({"simplex", "fbm", "turbulence", "cellular"}));
+  cmd->add_option("--write-maps", o->write_maps,
+                  "write each map as FOLDER/<map>.h5 first (bands tau_v, B, V, R; the bottom row is the axis: "
+                  "what [axial] image = ... reads back)");
   cmd->callback([o] {
     std::vector<AxialSkip> modes;
     for (const std::string& m : o->modes) modes.push_back(parse_axial_skip(m, "--modes"));
+    if (!o->write_maps.empty()) {
+      if (!std::filesystem::is_directory(o->write_maps))
+        throw Error("--write-maps: '" + o->write_maps + "' is not a folder");
+      for (const std::string& name : o->maps) {
+        // The benchmark's own map (bench_axial's sizes and densities).
+        const AxialMap map = synthetic_axial_map(name, o->map_size, o->map_size, 1.0f / o->map_size, 3, 2.0f);
+        Image image(map.nx, map.nr, {"tau_v", "B", "V", "R"});
+        for (int ir = 0; ir < map.nr; ++ir)
+          for (int ix = 0; ix < map.nx; ++ix) {
+            const size_t i = map.index(ix, ir);
+            const int y = map.nr - 1 - ir;
+            image.at(0, ix, y) = map.tau_v[i];
+            for (int b = 0; b < 3; ++b) image.at(b + 1, ix, y) = map.emission[size_t(b)][i];
+          }
+        const std::string path = (std::filesystem::path(o->write_maps) / (name + ".h5")).string();
+        write_image(image, path, ImageMetadata{}, true);
+        std::printf("wrote %s (%d x %d texels, %.1f%% empty)\n", path.c_str(), map.nx, map.nr,
+                    100.0 * double(map.empty_texels) / double(map.count()));
+      }
+    }
+    NoiseKind kind = NoiseKind::Fbm;
+    parse_noise_kind(o->noise, kind);
+    std::vector<AxialDeformSettings> deforms;
+    if (o->deform == "off" || o->deform == "both") deforms.push_back(AxialDeformSettings{});
+    if (o->deform != "off") {
+      AxialDeformSettings d = bench_axial_deformations(kind);
+      d.colour = o->deform != "shape";
+      d.shape = o->deform != "colour";
+      deforms.push_back(d);
+    }
     for (Backend backend : bench_backends(o->backends)) {
       const int image = backend == Backend::Cpu ? std::max(1, o->image / 8) : o->image;
-      std::printf("\naxial maps, %s%s: map %d x %d texels, image %d x %d, step %g texel, %s; ms median of %d after a warm-up\n",
+      std::printf("\naxial maps, %s%s: map %d x %d texels, image %d x %d, step %g texel, %s; deformations %s (%s "
+                  "noise); ms median of %d after a warm-up\n",
                   to_string(backend), backend == Backend::Cuda ? (" (" + gpu_description() + ")").c_str() : "",
                   o->map_size, o->map_size, image, image, o->step,
                   o->emission_only ? "emission-absorption"
                   : o->diffuse     ? "one star on the axis (full physics) and the diffuse field"
                                    : "one star on the axis (full physics)",
-                  o->repeats);
-      std::printf("| map | inclination | mode | ran | ms | speed-up vs naive | max diff / peak | samples | diffuse bake ms |\n"
-                  "|---|---|---|---|---|---|---|---|---|\n");
+                  o->deform.c_str(), o->noise.c_str(), o->repeats);
+      std::printf("| map | empty texels | deformed | inclination | mode | ran | ms | speed-up vs naive | max diff / peak | "
+                  "samples | diffuse bake ms |\n"
+                  "|---|---|---|---|---|---|---|---|---|---|---|\n");
+      std::vector<AxialBenchRow> rows;
       bench_axial(backend, o->map_size, image, image, o->repeats, o->step, o->maps, o->inclinations, !o->emission_only,
-                  [](const AxialBenchRow& r) {
-                    std::printf("| %s | %d | %s | %s | %.3f | %.2f | %.3g | %llu | %.1f |\n", r.map.c_str(),
+                  [&rows](const AxialBenchRow& r) {
+                    std::printf("| %s | %.1f%% | %s | %d | %s | %s | %.3f | %.2f | %.3g | %llu | %.1f |\n",
+                                r.map.c_str(), 100.0 * r.empty_fraction, r.deformed ? "yes" : "no",
                                 r.inclination_deg, r.mode.c_str(), r.ran.c_str(), r.median_ms, r.speedup,
                                 r.max_difference, (unsigned long long)r.samples, r.diffuse_bake_ms);
                     std::fflush(stdout);
+                    rows.push_back(r);
                   },
-                  o->step_aside, modes, o->diffuse);
+                  o->step_aside, modes, o->diffuse, deforms);
+      std::vector<AxialSkip> shown = modes.empty() ? axial_skip_modes() : modes;
+      shown.erase(std::remove(shown.begin(), shown.end(), AxialSkip::Naive), shown.end());
+      shown.insert(shown.begin(), AxialSkip::Naive);
+      print_thesis_tables(rows, o->maps, shown);
     }
   });
 }

@@ -167,10 +167,11 @@ expect_failure(axial_channel "axial.tau_channel" render axial_image.toml --set a
 expect_failure(axial_smooth "--smooth" render axial.toml --smooth 0.5 -o bad.h5)
 expect_failure(bench_axial_map "--maps" bench axial --backend cpu --maps spiral)
 execute_process(COMMAND ${NEBULA} bench axial --backend cpu --map-size 16 --image 16 --repeats 1 --inclinations 0,90
-                        --maps bipolar,full --emission-only
+                        --maps bipolar,shells,full --emission-only
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-string(FIND "${out}" "| full | 90 | omega_multi | naive |" at)
-if(NOT rc EQUAL 0 OR at EQUAL -1)
+string(FIND "${out}" "| full | 0.0% | yes | 90 | omega_multi | naive |" at)
+string(FIND "${out}" "| thesis_omega_multi | 5.3x | 6.3x |" tables)
+if(NOT rc EQUAL 0 OR at EQUAL -1 OR tables EQUAL -1)
   message(FATAL_ERROR "bench axial failed (${rc}): ${out} ${err}")
 endif()
 

@@ -30,7 +30,7 @@ DiffuseBand band_of(const Band& b, const ScatteringTable* table) {
 // texels) and of its voxelization: equal up to the voxels' staircase, which
 // the 4^3 points per voxel make small (bounded here by 1%).
 TEST(AxialDiffuse, VoxelizationKeepsTheDust) {
-  for (const std::string name : {"lopsided", "shells", "full"}) {
+  for (const std::string name : {"cloud", "shells", "full"}) {
     const AxialMap map = synthetic_axial_map(name, 64, 32, 0.1f, 0, 1.0f);
     double rings = 0;
     for (int ir = 0; ir < map.nr; ++ir)
@@ -142,7 +142,7 @@ TEST(AxialDiffuse, ConservesEnergyAtAlbedoOne) {
 // Bounds from the discretisation differences of the single-scattering
 // comparison (axial_renderer_test.cpp: relative L1 0.15, flux 8%).
 TEST(AxialDiffuse, MatchesTheGridFieldOnTheVoxelizedMap) {
-  for (const std::string name : {"lopsided", "shells"}) {
+  for (const std::string name : {"cloud", "shells"}) {
     testing::AxialScene s(name, 48, 16, normalize(Vec3{1, 2, 3}), 50.0f, 1.0f);
     s.table = thin_table(0.6);
     for (auto& b : s.inputs.bands) b.g = 0.6f;

@@ -175,7 +175,7 @@ DensityGrid voxelize_axial_map(const AxialMap& map, float voxel, std::vector<std
 }
 
 const std::vector<std::string>& synthetic_axial_map_names() {
-  static const std::vector<std::string> names{"bipolar", "lopsided", "shells", "empty", "full"};
+  static const std::vector<std::string> names{"bipolar", "lopsided", "shells", "empty", "full", "cloud"};
   return names;
 }
 
@@ -183,7 +183,7 @@ AxialMap synthetic_axial_map(const std::string& name, int nx, int nr, float texe
                              float tau_scale) {
   const auto& names = synthetic_axial_map_names();
   if (std::find(names.begin(), names.end(), name) == names.end())
-    throw Error("axial map '" + name + "': not a synthetic map (known: bipolar, lopsided, shells, empty, full)");
+    throw Error("axial map '" + name + "': not a synthetic map (known: bipolar, lopsided, shells, empty, full, cloud)");
   if (nx < 2 || nr < 2) throw Error("axial map '" + name + "': needs at least 2 x 2 texels");
   AxialMap m;
   m.nx = nx;
@@ -196,6 +196,11 @@ AxialMap synthetic_axial_map(const std::string& name, int nx, int nr, float texe
   // Emission "colours" per band: bluish first band.
   const float colour[4] = {1.0f, 0.8f, 0.6f, 0.5f};
   const float aspect = float(nx) / float(nr);  // map length in radii
+  // The bipolar lobes and the shells keep their size relative to the map's
+  // length on maps shorter than 2 radii (a square map shows the same nebula
+  // as a 2:1 one, with empty space above it, as a square image of a round
+  // or thin nebula has); unchanged from 2:1 on.
+  const float fit = std::min(0.5f * aspect, 1.0f);
   for (int ir = 0; ir < nr; ++ir)
     for (int ix = 0; ix < nx; ++ix) {
       const float u = (ix + 0.5f) / nx;  // 0..1 along the axis
@@ -204,23 +209,37 @@ AxialMap synthetic_axial_map(const std::string& name, int nx, int nr, float texe
       if (name == "bipolar") {
         // Two thin-walled lobes meeting at a waist in the middle.
         const float s = std::fabs(2.0f * u - 1.0f);
-        const float wall = 0.45f * std::sin(kPi * std::min(s, 1.0f));
-        if (s > 0.03f && s < 0.97f && std::fabs(v - wall) < 0.012f) tau = 3.0f;
-        if (s < 0.03f && v < 0.05f) glow = 1.0f;  // a small emitting waist
+        const float wall = 0.45f * fit * std::sin(kPi * std::min(s, 1.0f));
+        if (s > 0.03f && s < 0.97f && std::fabs(v - wall) < 0.012f * fit) tau = 3.0f;
+        if (s < 0.03f && v < 0.05f * fit) glow = 1.0f;  // a small emitting waist
       } else if (name == "lopsided") {
-        // A dense cloud off the map's centre with a fainter tail to one side.
+        // Calabash-like (OH 231.8+4.2): a dense core off the map's centre
+        // with two unequal lobes along the axis, a long plume widening to one
+        // side and a short stub to the other; nothing outside them, so most
+        // texels are empty (docs/axial.md, "Maps", gives the fractions).
+        const float u0 = 0.3f, a = (u - u0) * aspect, b = v;
+        const float d2 = a * a / 0.015f + b * b / 0.03f;
+        float rho = d2 < 1.0f ? 4.0f * (1.0f - 0.5f * d2) : 0.0f;
+        if (u > u0 && u < 0.95f && b < 0.06f + 0.55f * (u - u0)) rho += 1.5f * std::exp(-(u - u0) * aspect / 0.8f);
+        if (u < u0 && u > 0.1f && b < 0.05f + 0.7f * (u0 - u)) rho += 1.0f * std::exp(-(u0 - u) * aspect / 0.3f);
+        tau = rho;
+        if (d2 < 1.0f) glow = 2.0f;  // the core shines
+      } else if (name == "shells") {
+        // Three concentric spherical shells about the map's centre.
+        const float a = (u - 0.5f) * aspect, rho = std::sqrt(a * a + v * v) / fit;
+        for (float shell : {0.3f, 0.55f, 0.8f})
+          if (std::fabs(rho - shell) < (shell < 0.5f ? 0.08f : 0.05f)) tau = 2.0f;
+        if (std::fabs(rho - 0.3f) < 0.03f) glow = 1.0f;
+      } else if (name == "cloud") {
+        // The lopsided map before issue 15: a dense cloud off the map's
+        // centre with a fainter tail to one side, no empty texel below its
+        // height map (the validation scenes of docs/diffuse.md use it).
         const float a = (u - 0.32f) * aspect, b = v;
         const float d2 = a * a / 0.08f + b * b / 0.25f;
         const float tail = (u > 0.32f) ? std::exp(-((u - 0.32f) * aspect) / 0.6f) * std::exp(-b * b / 0.05f) : 0.0f;
         const float rho = 4.0f * std::exp(-d2) + 1.5f * tail;
         if (rho > 0.02f) tau = rho;
         if (d2 < 0.15f) glow = 2.0f;
-      } else if (name == "shells") {
-        // Three concentric spherical shells about the map's centre.
-        const float a = (u - 0.5f) * aspect, rho = std::sqrt(a * a + v * v);
-        for (float shell : {0.3f, 0.55f, 0.8f})
-          if (std::fabs(rho - shell) < 0.03f) tau = 2.0f;
-        if (std::fabs(rho - 0.3f) < 0.03f) glow = 1.0f;
       } else if (name == "full") {
         tau = 0.5f + 0.5f * u;
         glow = 0.2f;

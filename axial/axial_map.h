@@ -150,10 +150,13 @@ void check_axial_map(const AxialMap& map, const std::string& what);
 struct DensityGrid;
 DensityGrid voxelize_axial_map(const AxialMap& map, float voxel, std::vector<std::vector<float>>* emission);
 
-// The built-in maps: "bipolar" (two thin-walled lobes: mostly empty),
-// "lopsided" (a dense asymmetric cloud with an emitting core), "shells"
-// (three round concentric shells, the inner one emitting), "empty" and
-// "full" (dust and emission in every texel). `tau_scale` multiplies tau_v
+// The built-in maps, after the thesis' cases (docs/axial.md, "Maps", states
+// their empty fractions): "bipolar" (two thin-walled lobes, like M2-9: mostly
+// empty), "lopsided" (like the Calabash nebula: a dense off-centre core with a
+// long lobe to one side and a short one to the other, most texels empty),
+// "shells" (round, like NGC 6826: three concentric shells, the inner one
+// emitting), "empty", "full" (dust and emission in every texel) and "cloud"
+// (the lopsided map before issue 15: a dense cloud with a tail). `tau_scale` multiplies tau_v
 // (which is given per map radius, so the optical depths do not depend on
 // nr); emission gets `n_emission_bands` planes (0: none). The map is
 // nx x nr texels of edge `texel`, its axis through `origin` along `axis`.

@@ -21,6 +21,7 @@
 #include <cmath>
 #include <type_traits>
 
+#include "axial/axial_deform.h"
 #include "axial/axial_map.h"
 #include "core/hd.h"
 #include "core/vec3.h"
@@ -31,16 +32,25 @@
 
 namespace nebula {
 
-// Naive to OmegaMulti are the thesis' modes, ordered: each does everything
-// the previous one does. Distance is ours: GlobalMax's clipping, then jumps
-// sized by the distance map (proximity clouds) instead of omega attempts.
+// Naive to OmegaMulti are the project's versions of the thesis' modes,
+// ordered: each does everything the previous one does. Distance is ours:
+// GlobalMax's clipping, then jumps sized by the distance map (proximity
+// clouds) instead of omega attempts. ThesisOmega* are the thesis' modes as
+// its sections 3.1 and 5.1.2 define them (docs/axial.md, "The thesis' modes"):
+// the height map's emptiness check on every sample, and from an empty sample
+// a step of omega_max = t_exit - t_entry, the ray's interval inside the
+// largest max-tree node the sample lies above, or a fraction of it; a step
+// that fails falls back to the next sample, which is checked again.
 enum class AxialSkip : int {
   Naive = 0,       // every sample: texel fetch and shading
   Empty = 1,       // the height and floor maps decide a sample is empty before any texel fetch
   GlobalMax = 2,   // ... and only the samples inside the cylinder of radius H l are visited
   Omega = 3,       // ... and from an empty sample, jump omega_max (the rest) or omega_large = omega_max / 32
   OmegaMulti = 4,  // ... adaptive jumps (doubling on success, halving on failure), range maxima from the max-tree
-  Distance = 5     // GlobalMax, then from every empty sample the longest jump its texel's distance allows
+  Distance = 5,    // GlobalMax, then from every empty sample the longest jump its texel's distance allows
+  ThesisOmegaMax = 6,    // the thesis' omega_max: a step of the node's t_exit - t_entry
+  ThesisOmegaLarge = 7,  // the thesis' omega_large: a step of omega_max / 32
+  ThesisOmegaMulti = 8   // the thesis' omega_multi: omega_max, omega_max / 2, ... omega_max / 32 tried in that order
 };
 
 const char* to_string(AxialSkip mode);
@@ -59,6 +69,7 @@ struct AxialMarchScene {
   RayFootprint footprint;  // the camera's pixel width along a ray (starlight near a star)
   bool has_diffuse = false;  // light scattered between cells (axial/axial_diffuse.h), per band where baked
   DiffuseView diffuse;       // cells {along the axis, from it, 1}, harmonics in the meridian frames
+  AxialDeformView deform;    // colour and shape deformations (axial_deform.h), read by the kDeform kernels
 };
 
 // The diffuse field's light a texel of V-band depth tau_v at sample point q
@@ -178,9 +189,13 @@ NEBULA_HD float min_radius(const AxialRay& ray, float ta, float tb) {
 
 // Whether every point of the ray with t in [ta, tb], grown by eps on every
 // side, lies above the height map or below the floor map of the columns it
-// crosses: then every sample there is empty.
-template <bool kTree>
-NEBULA_HD bool stretch_is_empty(const AxialView& m, const AxialRay& ray, float ta, float tb, float eps) {
+// crosses: then every sample there is empty. With shape deformations a
+// sample at r reads a texel at some r' in [r shrink, r] (shrink = 1 - d_max):
+// above the height map then needs r_min shrink >= h l + eps; below the floor
+// needs nothing more (r' <= r). kFloor false: the height map only (the thesis).
+template <bool kTree, bool kFloor = true>
+NEBULA_HD bool stretch_is_empty(const AxialView& m, const AxialRay& ray, float ta, float tb, float eps,
+                                float shrink = 1.0f) {
   ta -= eps;
   tb += eps;
   const float xa = ray.x0 + ta * ray.dx, xb = ray.x0 + tb * ray.dx;
@@ -194,15 +209,15 @@ NEBULA_HD bool stretch_is_empty(const AxialView& m, const AxialRay& ray, float t
   const float r_max = fmaxf(length(ray.w0 + ta * ray.wd), length(ray.w0 + tb * ray.wd));
   if (kTree) {
     const int h = m.range_max_tree(lo, hi);
-    if (h == 0 || r_min >= h * m.texel + eps) return true;
-    return r_max + eps <= m.range_min_floor(lo, hi) * m.texel;
+    if (h == 0 || r_min * shrink >= h * m.texel + eps) return true;
+    return kFloor && r_max + eps <= m.range_min_floor(lo, hi) * m.texel;
   }
   // The scan stops as soon as neither holds.
   bool above = true, below = true;
   for (int i = lo; i <= hi; ++i) {
     if (m.height[i] == 0) continue;  // an empty column
-    above = above && r_min >= m.height[i] * m.texel + eps;
-    below = below && r_max + eps <= m.floor[i] * m.texel;
+    above = above && r_min * shrink >= m.height[i] * m.texel + eps;
+    below = below && kFloor && r_max + eps <= m.floor[i] * m.texel;
     if (!above && !below) return false;
   }
   return true;
@@ -222,17 +237,72 @@ NEBULA_HD float distance_reach(int d, float texel, float inv_speed, float eps) {
   return (float(d - 1) * texel - eps) * inv_speed;
 }
 
+// The thesis' omega_max at a sample at t in column ix whose smallest read
+// radius is r_lo: the current max-tree node is the largest node holding ix
+// whose height h lies below the sample (h l + eps <= r_lo); its interval is
+// the part of the ray inside the node's x-slab and outside the cylinder of
+// radius h l / shrink (where no sample can read a non-empty texel of the
+// node's columns), clipped to [t_in, t_out]; omega_max = t_exit - t_entry of
+// the piece holding t, in whole samples (0 when no node lies below the
+// sample). Float arithmetic: the step it suggests is checked before it is
+// taken, so its rounding changes speed, never the image.
+NEBULA_HD int thesis_omega_max(const AxialView& m, const AxialRay& ray, int ix, float r_lo, float t, float t_in,
+                               float t_out, float inv_h, float eps, float shrink) {
+  for (int level = m.n_levels - 1; level >= 0; --level) {
+    const int node = ix >> level;
+    const int height = m.tree[m.level_offset[level] + node];
+    if (!(float(height) * m.texel + eps <= r_lo)) continue;
+    const int c0 = node << level, c1 = (node + 1) << level;
+    const float xa = float(c0) * m.texel, xb = float(c1 < m.nx ? c1 : m.nx) * m.texel;
+    float t_entry = t_in, t_exit = t_out;
+    if (ray.dx != 0.0f) {
+      float ta = (xa - ray.x0) / ray.dx, tb = (xb - ray.x0) / ray.dx;
+      if (ta > tb) {
+        const float swap = ta;
+        ta = tb;
+        tb = swap;
+      }
+      t_entry = fmaxf(t_entry, ta);
+      t_exit = fminf(t_exit, tb);
+    }
+    if (height > 0) {
+      // Where the ray is inside the node's cylinder: (ca, cb), the roots of |w0 + t wd| = rho.
+      const float rho = float(height) * m.texel / shrink;
+      const float A = dot(ray.wd, ray.wd), B = dot(ray.w0, ray.wd), C = dot(ray.w0, ray.w0) - rho * rho;
+      const float disc = B * B - A * C;
+      if (A > 0.0f && disc > 0.0f) {
+        const float root = sqrtf(disc), ca = (-B - root) / A, cb = (-B + root) / A;
+        if (t <= ca) t_exit = fminf(t_exit, ca);
+        else if (t >= cb) t_entry = fmaxf(t_entry, cb);
+        else return 0;  // within rounding of the cylinder: no step
+      }
+    }
+    const float n = floorf((t_exit - t_entry) * inv_h);
+    return n >= 1.0f ? static_cast<int>(fminf(n, 1e8f)) : 0;
+  }
+  return 0;
+}
+
 }  // namespace axial_detail
 
 // One ray through the axial map: radiance and transmittance per band. The
-// skip mode (s.skip is not read), whether there are stars and whether there
-// is a diffuse field (s.has_diffuse is not read) are fixed at compile time, so
+// skip mode (s.skip is not read), whether there are stars, whether there is a
+// diffuse field (s.has_diffuse is not read) and whether the scene has
+// deformations (kDeform; which ones: s.deform) are fixed at compile time, so
 // each kernel holds only what its scene needs (a scene without stars carries
 // no table lookups in its registers). With the field, its light adds to the
 // texel's source and its forward peak to the texel's transmittance, as in the
 // grid marcher (ray_march.h). `visited` (may be null) counts the samples the
 // loop stepped through.
-template <AxialSkip kMode, bool kStars, bool kDiffuse = false>
+//
+// Deformations (axial_deform.h, docs/axial.md "Asymmetry"): a shape-deformed
+// sample at r reads the texel at r (1 - d), d in [0, d_max], so every
+// emptiness proof covers the whole radial interval [r (1 - d_max), r] before
+// the pull is looked up: the height test uses its lower end, the floor test
+// its upper end, the distance jump the distance map at its middle less half
+// its width. The colour factors only lower a non-empty texel's values, so
+// they change no proof.
+template <AxialSkip kMode, bool kStars, bool kDiffuse = false, bool kDeform = false>
 NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 dir, int* visited = nullptr) {
   RayResult out{};
   for (int b = 0; b < kMaxBands; ++b) out.transmittance[b] = 1.0f;
@@ -251,10 +321,16 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
   const float scale = length(origin - m.origin) + t_out + m.length() + m.radius();
   const float eps = 1e-3f * m.texel + 1e-5f * scale;
   constexpr int skip = static_cast<int>(kMode);
-  if (skip >= int(AxialSkip::GlobalMax)) {
+  constexpr bool kThesis = skip >= int(AxialSkip::ThesisOmegaMax);
+  const AxialDeformView& deform = s.deform;
+  const bool shape = kDeform && deform.shape;
+  const float shrink = shape ? deform.shrink : 1.0f;  // a sample at r reads r' >= r shrink
+  if (skip >= int(AxialSkip::GlobalMax) && !kThesis) {
     if (m.global_max == 0) return out;
     float ta, tb;
-    if (!intersect_cylinder(ray, -eps, m.length() + eps, m.global_max * m.texel + eps, ta, tb)) return out;
+    // Beyond r = H l / shrink every read radius r' >= r shrink is above the map.
+    const float clip = shape ? m.global_max * m.texel / shrink : m.global_max * m.texel;
+    if (!intersect_cylinder(ray, -eps, m.length() + eps, clip + eps, ta, tb)) return out;
     // Samples whose positions t_in + (k + 1/2) h lie before ta or after tb are empty.
     const float first = floorf((ta - t_in) / h - 0.5f) - 1.0f, last = ceilf((tb - t_in) / h - 0.5f) + 1.0f;
     k_begin = first > 0.0f ? static_cast<int>(fminf(first, n_samples)) : 0;
@@ -284,24 +360,66 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
     const Vec3 pos = origin + t * dir;
     const Vec3 q = pos - m.origin;
     const float x = dot(q, m.axis);
-    const float r = length(q - x * m.axis);
+    const Vec3 w = q - x * m.axis;
+    const float r = length(w);
     const float fx = floorf(x * inv_texel), fr = floorf(r * inv_texel);
-    bool empty = !(fx >= 0.0f && fx < float(m.nx) && fr < float(m.nr));  // outside (or NaN)
+    const bool outside = !(fx >= 0.0f && fx < float(m.nx) && fr < float(m.nr));  // (or NaN)
+    bool empty = outside;
     const int ix = empty ? 0 : static_cast<int>(fx), ir = empty ? 0 : static_cast<int>(fr);
-    int distance = 0;  // the sample's texel's, Distance mode only
+    // The texel the sample reads: (ix, ir), or with a shape deformation (ix,
+    // floor(r (1 - d) / l)), the same expression in every mode.
+    int ir_read = ir;
+    bool pulled = false;
+    auto pull = [&]() {
+      if (pulled) return;
+      pulled = true;
+      const float d = shape_pull(deform, ix, w);
+      ir_read = static_cast<int>(floorf(r * (1.0f - d) * inv_texel));
+    };
+    int distance = 0;  // the jump's distance (Distance mode only)
+    float reach_slack = 0.0f;  // world units the jump may cover times the speed
     if (!empty && skip == int(AxialSkip::Distance)) {
-      distance = m.distance[m.index(ix, ir)];
-      empty = distance != 0;
+      if (!shape) {
+        distance = m.distance[m.index(ix, ir)];
+        empty = distance != 0;
+        reach_slack = float(distance - 1) * m.texel - eps;
+      } else {
+        // Every read radius lies within half = r d_max / 2 of r - half.
+        const float half = 0.5f * deform.d_max * r;
+        const int ic = static_cast<int>(floorf((r - half) * inv_texel));
+        const int d = m.distance[m.index(ix, ic)];
+        reach_slack = float(d - 1) * m.texel - eps - half;
+        if (d != 0 && reach_slack >= 0.0f) {
+          distance = d;
+          empty = true;
+        } else {
+          pull();
+          empty = m.distance[m.index(ix, ir_read)] != 0;
+        }
+      }
     } else if (!empty && skip >= int(AxialSkip::Empty)) {
-      empty = ir >= m.height[ix] || ir < m.floor[ix];
+      const int top = m.height[ix];
+      if (shape) {
+        const int ir_lo = static_cast<int>(floorf(r * shrink * inv_texel));
+        empty = ir_lo >= top || (!kThesis && ir < m.floor[ix]);
+        if (!empty) {
+          pull();
+          empty = ir_read >= top || (!kThesis && ir_read < m.floor[ix]);
+        }
+      } else {
+        empty = ir >= top || (!kThesis && ir < m.floor[ix]);
+      }
     }
     if (skip == int(AxialSkip::Naive) || !empty) {
       float tau_v = 0.0f;
       float source[kMaxBands] = {};
       float peak[kMaxBands] = {};  // the diffuse response's forward peak (kDiffuse)
+      float lower[kMaxBands];      // colour deformation factors (kDeform)
+      for (int b = 0; b < kMaxBands; ++b) lower[b] = 1.0f;
       bool dark = true;
       if (!empty) {
-        const size_t cell = m.index(ix, ir);
+        if (shape) pull();
+        const size_t cell = m.index(ix, ir_read);
         tau_v = m.tau_v[cell];
         NEBULA_UNROLL
         for (int b = 0; b < kMaxBands; ++b) {
@@ -319,10 +437,20 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
         }
         if constexpr (kDiffuse)
           if (tau_v > 0.0f) add_axial_diffuse_light(s, q, x, r, tau_v, to_eye, source, peak);
+        if constexpr (kDeform)
+          if (deform.colour && !dark) {
+            colour_factors(deform, q, s.n_bands, lower);
+            NEBULA_UNROLL
+            for (int b = 0; b < kMaxBands; ++b) {
+              if (b >= s.n_bands) break;
+              source[b] *= lower[b];
+              peak[b] *= lower[b];
+            }
+          }
       }
       empty = empty || dark;
       // T_in rule (DESIGN.md section 3), the texel in the voxel's part.
-      const long long cell = empty ? -1 : static_cast<long long>(m.index(ix, ir));
+      const long long cell = empty ? -1 : static_cast<long long>(m.index(ix, ir_read));
       if (cell != run_cell) {
         NEBULA_UNROLL
         for (int b = 0; b < kMaxBands; ++b)
@@ -335,10 +463,12 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
       for (int b = 0; b < kMaxBands; ++b) {
         if (b >= s.n_bands) break;
         out.radiance[b] += t_entry[b] * source[b] * fraction;
+        float tau_b = tau_v * s.extinction_ratio[b];
+        if constexpr (kDeform) tau_b *= lower[b];
         if constexpr (kDiffuse)
-          out.transmittance[b] *= fminf(1.0f, expf(-tau_v * s.extinction_ratio[b] * fraction) + peak[b] * fraction);
+          out.transmittance[b] *= fminf(1.0f, expf(-tau_b * fraction) + peak[b] * fraction);
         else
-          out.transmittance[b] *= expf(-tau_v * s.extinction_ratio[b] * fraction);
+          out.transmittance[b] *= expf(-tau_b * fraction);
         visible = visible || out.transmittance[b] >= s.min_transmittance;
       }
       if (!visible) break;
@@ -347,10 +477,33 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
     const bool gap_start = !previous_empty;
     previous_empty = empty;
     if (!empty || skip < int(AxialSkip::Omega)) continue;
+    if (kThesis) {
+      // The thesis' steps: omega_max from the node the sample lies above,
+      // omega_large = omega_max / 32, or omega_max, omega_max / 2, ...,
+      // omega_max / 32 in turn; a step is taken when the stretch up to its
+      // landing sample is above the height map (max-tree range maximum).
+      if (outside) continue;
+      const int rest = k_end - 1 - k;
+      if (rest < 1) continue;
+      const int omega_max =
+          axial_detail::thesis_omega_max(m, ray, ix, r * shrink, t, t_in, t_out, inv_h, eps, shrink);
+      const int first = skip == int(AxialSkip::ThesisOmegaLarge) ? 5 : 0;
+      const int last = skip == int(AxialSkip::ThesisOmegaMulti) ? 5 : first;
+      for (int halving = first; halving <= last; ++halving) {
+        int n = omega_max >> halving;
+        n = n < rest ? n : rest;
+        if (n < 1) break;
+        if (axial_detail::stretch_is_empty<true, false>(m, ray, t, t + float(n) * h, eps, shrink)) {
+          k += n;
+          break;
+        }
+      }
+      continue;
+    }
     if (skip == int(AxialSkip::Distance)) {
       // Every sample within reach is empty: jump over all of them.
-      if (distance == 0) continue;  // outside the map: no texel, no distance
-      const float reach = axial_detail::distance_reach(distance, m.texel, inv_speed, eps);
+      if (distance == 0) continue;  // outside the map, or not proven for a pulled sample
+      const float reach = reach_slack * inv_speed;
       // reach * (1/h) may round up by an ulp of reach: far inside the margin eps.
       const float n = fminf(floorf(reach * inv_h), float(k_end - 1 - k));
       if (n >= 1.0f) k += static_cast<int>(n);
@@ -363,8 +516,8 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
     const int rest = k_end - 1 - k;
     if (rest < 2) continue;
     if (gap_start && (skip == int(AxialSkip::Omega)
-                          ? axial_detail::stretch_is_empty<false>(m, ray, t, t + float(rest) * h, eps)
-                          : axial_detail::stretch_is_empty<true>(m, ray, t, t + float(rest) * h, eps)))
+                          ? axial_detail::stretch_is_empty<false>(m, ray, t, t + float(rest) * h, eps, shrink)
+                          : axial_detail::stretch_is_empty<true>(m, ray, t, t + float(rest) * h, eps, shrink)))
       break;  // omega_max: the rest of the ray, tried once per run of empty samples
     if (wait > 0) {
       --wait;
@@ -374,7 +527,7 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
     if (skip == int(AxialSkip::Omega)) {
       // omega_large = omega_max / 32, the columns' maximum scanned.
       const int n = omega_large < rest ? omega_large : rest;
-      if (n >= 2 && axial_detail::stretch_is_empty<false>(m, ray, t, t + float(n) * h, eps)) {
+      if (n >= 2 && axial_detail::stretch_is_empty<false>(m, ray, t, t + float(n) * h, eps, shrink)) {
         k += n;
         jumped = true;
       }
@@ -382,7 +535,7 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
       // Hierarchical: one adaptive jump, n doubling after each success and
       // halving after a failure, range extrema from the trees (O(log nx)).
       const int n = stride < rest ? stride : rest;
-      if (n >= 2 && axial_detail::stretch_is_empty<true>(m, ray, t, t + float(n) * h, eps)) {
+      if (n >= 2 && axial_detail::stretch_is_empty<true>(m, ray, t, t + float(n) * h, eps, shrink)) {
         k += n;
         stride = 2 * n;
         jumped = true;
@@ -400,15 +553,21 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
   return out;
 }
 
-// Calls f(mode, stars, diffuse) with std::integral_constant / std::bool_constant
-// for the run-time mode, whether the scene has stars and whether it has a
-// diffuse field (only with stars): the one place that turns them into
-// template arguments (the CPU loop, the CUDA launch).
+// Calls f(mode, stars, diffuse, deform) with std::integral_constant /
+// std::bool_constant for the run-time mode, whether the scene has stars,
+// whether it has a diffuse field (only with stars) and whether it has
+// deformations: the one place that turns them into template arguments (the
+// CPU loop, the CUDA launch).
 template <class F>
-decltype(auto) dispatch_axial(AxialSkip mode, bool stars, bool diffuse, F&& f) {
+decltype(auto) dispatch_axial(AxialSkip mode, bool stars, bool diffuse, bool deform, F&& f) {
+  auto with_deform = [&](auto m, auto st, auto di) -> decltype(auto) {
+    if (deform) return f(m, st, di, std::true_type{});
+    return f(m, st, di, std::false_type{});
+  };
   auto with_stars = [&](auto m) -> decltype(auto) {
-    if (!stars) return f(m, std::false_type{}, std::false_type{});
-    return diffuse ? f(m, std::true_type{}, std::true_type{}) : f(m, std::true_type{}, std::false_type{});
+    if (!stars) return with_deform(m, std::false_type{}, std::false_type{});
+    return diffuse ? with_deform(m, std::true_type{}, std::true_type{})
+                   : with_deform(m, std::true_type{}, std::false_type{});
   };
   switch (mode) {
     case AxialSkip::Naive: return with_stars(std::integral_constant<AxialSkip, AxialSkip::Naive>{});
@@ -416,6 +575,12 @@ decltype(auto) dispatch_axial(AxialSkip mode, bool stars, bool diffuse, F&& f) {
     case AxialSkip::GlobalMax: return with_stars(std::integral_constant<AxialSkip, AxialSkip::GlobalMax>{});
     case AxialSkip::Omega: return with_stars(std::integral_constant<AxialSkip, AxialSkip::Omega>{});
     case AxialSkip::OmegaMulti: return with_stars(std::integral_constant<AxialSkip, AxialSkip::OmegaMulti>{});
+    case AxialSkip::ThesisOmegaMax:
+      return with_stars(std::integral_constant<AxialSkip, AxialSkip::ThesisOmegaMax>{});
+    case AxialSkip::ThesisOmegaLarge:
+      return with_stars(std::integral_constant<AxialSkip, AxialSkip::ThesisOmegaLarge>{});
+    case AxialSkip::ThesisOmegaMulti:
+      return with_stars(std::integral_constant<AxialSkip, AxialSkip::ThesisOmegaMulti>{});
     case AxialSkip::Distance: break;
   }
   return with_stars(std::integral_constant<AxialSkip, AxialSkip::Distance>{});

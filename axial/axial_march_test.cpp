@@ -12,8 +12,9 @@ namespace {
 
 using testing::AxialScene;
 
-constexpr AxialSkip kSkips[] = {AxialSkip::Empty, AxialSkip::GlobalMax, AxialSkip::Omega, AxialSkip::OmegaMulti,
-                                AxialSkip::Distance};
+constexpr AxialSkip kSkips[] = {AxialSkip::Empty,          AxialSkip::GlobalMax,        AxialSkip::Omega,
+                                AxialSkip::OmegaMulti,     AxialSkip::Distance,         AxialSkip::ThesisOmegaMax,
+                                AxialSkip::ThesisOmegaLarge, AxialSkip::ThesisOmegaMulti};
 
 AxialView unit_map(int nx, int nr, float texel) {
   AxialView v;
@@ -253,14 +254,17 @@ TEST(AxialSkipping, HardRaysAreBitIdenticalToo) {
 }
 
 // The skipping modes do skip: samples visited on the thin map at 45 degrees,
-// each of the thesis' modes no more than the one before it, omega_multi a
-// small fraction of naive, and the distance mode fewer than global_max (whose
-// clipping it shares) on the thin map and on the hollow shells.
+// each of the project's versions of the thesis' modes no more than the one
+// before it, omega_multi a small fraction of naive, and the distance mode
+// fewer than global_max (whose clipping it shares) on the thin map and on the
+// hollow shells. The thesis' own modes: omega_multi (which tries omega_max
+// first) no more than omega_max, each fewer than naive, and omega_multi a
+// small fraction of naive on the thin map.
 TEST(AxialSkipping, ModesReadFewerTexels) {
   for (const std::string name : {"bipolar", "shells"}) {
     AxialScene s(name, 128, 48);
     s.inputs.camera = s.view(45, 32, 0);
-    uint64_t previous = ~uint64_t(0), naive = 0, global_max = 0;
+    uint64_t previous = ~uint64_t(0), naive = 0, global_max = 0, thesis_max = 0;
     for (AxialSkip mode : axial_skip_modes()) {
       s.inputs.skip = mode;
       AxialRenderStats stats;
@@ -268,7 +272,16 @@ TEST(AxialSkipping, ModesReadFewerTexels) {
       std::printf("%-8s %-12s %llu samples visited\n", name.c_str(), to_string(mode), (unsigned long long)stats.samples);
       if (mode == AxialSkip::Naive) naive = stats.samples;
       if (mode == AxialSkip::GlobalMax) global_max = stats.samples;
-      if (mode == AxialSkip::Distance) {
+      if (mode >= AxialSkip::ThesisOmegaMax) {
+        EXPECT_LT(stats.samples, naive) << name << " " << to_string(mode);
+        if (mode == AxialSkip::ThesisOmegaMax) thesis_max = stats.samples;
+        if (mode == AxialSkip::ThesisOmegaMulti) {
+          EXPECT_LE(stats.samples, thesis_max) << name;
+          if (name == std::string("bipolar")) {
+            EXPECT_LT(stats.samples * 5, naive);
+          }
+        }
+      } else if (mode == AxialSkip::Distance) {
         EXPECT_LT(stats.samples, global_max) << name;
         if (name == "bipolar") {
           EXPECT_LT(stats.samples * 10, naive);

@@ -22,13 +22,18 @@ const char* to_string(AxialSkip mode) {
     case AxialSkip::Omega: return "omega";
     case AxialSkip::OmegaMulti: return "omega_multi";
     case AxialSkip::Distance: return "distance";
+    case AxialSkip::ThesisOmegaMax: return "thesis_omega_max";
+    case AxialSkip::ThesisOmegaLarge: return "thesis_omega_large";
+    case AxialSkip::ThesisOmegaMulti: return "thesis_omega_multi";
   }
   return "?";
 }
 
 const std::vector<AxialSkip>& axial_skip_modes() {
   static const std::vector<AxialSkip> modes{AxialSkip::Naive, AxialSkip::Empty, AxialSkip::GlobalMax,
-                                            AxialSkip::Omega, AxialSkip::OmegaMulti, AxialSkip::Distance};
+                                            AxialSkip::Omega, AxialSkip::OmegaMulti, AxialSkip::Distance,
+                                            AxialSkip::ThesisOmegaMax, AxialSkip::ThesisOmegaLarge,
+                                            AxialSkip::ThesisOmegaMulti};
   return modes;
 }
 
@@ -76,6 +81,8 @@ void validate(const AxialRenderInputs& in) {
       throw Error("axial render: star " + std::to_string(k) + " lies " + to_text(off) +
                   " from the axis; stars must be on the axis (then their light is axisymmetric)");
   }
+  if (in.deform.colour) check_noise(in.deform.colour_noise, false, "axial render: colour deformation");
+  if (in.deform.shape) check_noise(in.deform.shape_noise, true, "axial render: shape deformation");
   if (in.diffuse) {
     const DiffuseField& f = *in.diffuse;
     if (f.cells.nz != 1 || f.cells.nx < 1 || f.cells.ny < 1 || !(f.cells.voxel > 0) || f.n_bands() != in.bands.size())
@@ -91,7 +98,8 @@ Image render_axial_cpu(const AxialRenderInputs& in, AxialRenderStats* stats) {
   Image image(in.camera.width, in.camera.height, band_names(in.bands));
   std::atomic<uint64_t> clamps{0}, reads{0};
   const auto start = std::chrono::steady_clock::now();
-  dispatch_axial(scene.skip, scene.n_stars > 0, scene.has_diffuse, [&](auto mode, auto has_stars, auto diffuse) {
+  dispatch_axial(scene.skip, scene.n_stars > 0, scene.has_diffuse, in.deform.any(),
+                 [&](auto mode, auto has_stars, auto diffuse, auto deform) {
     tbb::parallel_for(tbb::blocked_range<int>(0, in.camera.height), [&](const auto& rows) {
       uint64_t local = 0, local_reads = 0;
       for (int y = rows.begin(); y != rows.end(); ++y)
@@ -100,8 +108,8 @@ Image render_axial_cpu(const AxialRenderInputs& in, AxialRenderStats* stats) {
           if (!in.camera.ray(x, y, origin, dir)) continue;
           int visited = 0;
           const RayResult r =
-              march_axial_ray<decltype(mode)::value, decltype(has_stars)::value, decltype(diffuse)::value>(
-                  scene, origin, dir, &visited);
+              march_axial_ray<decltype(mode)::value, decltype(has_stars)::value, decltype(diffuse)::value,
+                              decltype(deform)::value>(scene, origin, dir, &visited);
           local_reads += uint64_t(visited);
           store_radiance(r, scene.n_bands, in.exposure, image.pixels.data(), image.width, image.height, x, y);
           local += uint64_t(r.table_clamps);

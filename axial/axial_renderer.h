@@ -33,6 +33,9 @@ struct AxialRenderInputs {
   // Light scattered between cells (axial_diffuse.h), baked for this map,
   // these bands and stars; null: single scattering (and the table's own).
   const DiffuseField* diffuse = nullptr;
+  // Colour and shape deformations (axial_deform.h; Khalass 2021 section 3.2).
+  // The stars' depths and the diffuse field stay those of the undeformed map.
+  AxialDeformSettings deform;
   Camera camera;
   float exposure = 1.0f;
   float min_transmittance = 1e-4f;
@@ -58,7 +61,8 @@ float effective_step(const AxialRenderInputs& in);
 AxialSkip effective_skip(const AxialRenderInputs& in);
 // Every mode, naive first.
 const std::vector<AxialSkip>& axial_skip_modes();
-// "naive", "empty", "global_max", "omega", "omega_multi", "distance"; Error naming `option` otherwise.
+// "naive", "empty", "global_max", "omega", "omega_multi", "distance", "thesis_omega_max",
+// "thesis_omega_large", "thesis_omega_multi"; Error naming `option` otherwise.
 AxialSkip parse_axial_skip(const std::string& text, const std::string& option);
 
 Image render_axial(const AxialRenderInputs& in, Backend backend, AxialRenderStats* stats = nullptr);

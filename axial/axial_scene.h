@@ -37,6 +37,19 @@ AxialMarchScene assemble_axial_scene(const AxialRenderInputs& in, Place& place) 
   }
   scene.stars = place_star_views(in.stars, scene.n_bands, place);
   scene.n_stars = static_cast<int>(in.stars.size());
+  if (in.deform.any()) {
+    AxialDeformView& d = scene.deform;
+    d.colour = in.deform.colour;
+    d.colour_noise = in.deform.colour_noise;
+    d.inv_length = 1.0f / m.length();
+    d.shape = in.deform.shape;
+    if (d.shape) {
+      d.d_max = in.deform.shape_noise.amplitude;
+      d.shrink = 1.0f - d.d_max;  // the expression the march's 1 - d takes at d = d_max
+      d.pull = place.keep(bake_shape_pull(in.deform.shape_noise, m.nx, m.texel, m.radius()));
+    }
+    deform_frame(m.axis, d.e1, d.e2);
+  }
   if (in.diffuse && scene.n_stars > 0) {
     scene.has_diffuse = true;
     scene.diffuse = place_diffuse(*in.diffuse, place);

@@ -19,6 +19,19 @@ using namespace pipeline_detail;
 
 namespace {
 
+// A scene's deformation keys as the renderer takes them (axial/axial_deform.h).
+NoiseParams noise_params(const AxialNoiseSpec& n, const std::string& key) {
+  NoiseParams p;
+  if (!parse_noise_kind(n.kind, p.kind)) throw ParameterError(key + ".kind", "'" + n.kind + "' is not a noise kind");
+  p.frequency = static_cast<float>(n.frequency);
+  p.octaves = n.octaves;
+  p.gain = static_cast<float>(n.gain);
+  p.lacunarity = static_cast<float>(n.lacunarity);
+  p.amplitude = static_cast<float>(n.amplitude);
+  p.seed = n.seed;
+  return p;
+}
+
 RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
   if (o.smooth_step != 0) throw ParameterError("smooth_step", "not for axial maps (their step is axial.step_texels)");
   if (scene.multiple_scattering == MultipleScattering::Pyramid)
@@ -61,6 +74,8 @@ RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
   RunReport& report = out.report;
   report = begin_report(scene, sb, "axial", o.backend, scatters);
   report.mode = std::string("axial ") + to_string(skip) + " step " + to_text(spec.step_texels) + " texel";
+  if (spec.colour_deform.on) report.mode += ", colour deformation " + spec.colour_deform.kind;
+  if (spec.shape_deform.on) report.mode += ", shape deformation " + spec.shape_deform.kind;
   report.tables = tables.report;
 
   // Stars on the axis: one 2D bake each.
@@ -105,6 +120,10 @@ RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
   in.exposure = 1.0f;  // science pixels: the exposure goes in the metadata
   in.step = static_cast<float>(spec.step_texels * map.texel);
   in.skip = skip;
+  in.deform.colour = spec.colour_deform.on;
+  in.deform.colour_noise = noise_params(spec.colour_deform, scene.path + ": axial.colour_deform");
+  in.deform.shape = spec.shape_deform.on;
+  in.deform.shape_noise = noise_params(spec.shape_deform, scene.path + ": axial.shape_deform");
   AxialRenderStats stats;
   std::unique_ptr<Progress> bar;
   if (o.progress && o.backend == Backend::Cpu) bar = std::make_unique<Progress>("render", uint64_t(in.camera.height));

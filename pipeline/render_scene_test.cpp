@@ -402,6 +402,35 @@ TEST_F(RenderScene, AxialMapsAndTheTruthRunThroughTheSamePipeline) {
   EXPECT_EQ(axial_truth.image.width, 12);
 }
 
+// Deformations through the pipeline: the scene's tables reach the renderer
+// (the image changes; the report's mode names them), the resolved scene in
+// the metadata carries them, and the truth refuses them, naming the key.
+TEST_F(RenderScene, AxialDeformationsRunThroughThePipeline) {
+  const std::string base =
+      "bands = [\"B\", \"V\"]\n[axial]\nsynthetic = \"lopsided\"\nnx = 32\nnr = 16\nemission_scale = 1.0\n"
+      "[camera]\nkind = \"orthographic\"\nposition = [4.0, 0.0, 1.0]\nlook_at = [0.0, 0.0, 1.0]\northo_width = 2.4\n"
+      "width = 24\nheight = 24\n";
+  const Scene plain = load_scene(write_text("plain.toml", base));
+  const Scene deformed = load_scene(write_text(
+      "deformed.toml", base + "[axial.colour_deform]\namplitude = 0.9\n[axial.shape_deform]\namplitude = 0.4\n"));
+  const RenderOutput a = render_scene(plain, options());
+  const RenderOutput b = render_scene(deformed, options());
+  double diff = 0, sum = 0;
+  for (size_t i = 0; i < a.image.pixels.size(); ++i) {
+    ASSERT_TRUE(std::isfinite(b.image.pixels[i]));
+    diff += std::fabs(double(a.image.pixels[i]) - b.image.pixels[i]);
+    sum += std::fabs(double(a.image.pixels[i]));
+  }
+  EXPECT_GT(sum, 0.0);
+  EXPECT_GT(diff, 0.05 * sum);
+  EXPECT_NE(b.report.mode.find("colour deformation fbm"), std::string::npos) << b.report.mode;
+  EXPECT_NE(b.report.mode.find("shape deformation fbm"), std::string::npos) << b.report.mode;
+  EXPECT_NE(b.metadata.scene_text.find("colour_deform"), std::string::npos);
+  TruthOptions t;
+  t.spp = 2;
+  testing::expect_error([&] { truth_scene(deformed, t); }, {"axial.colour_deform", "undeformed map"});
+}
+
 // The truth traces an axial map voxelized in the map's own frame, the camera
 // moved with it: on a tilted axis, seen from the side, with emission only
 // and no scattering (which the axial marcher integrates without

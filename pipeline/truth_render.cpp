@@ -61,6 +61,12 @@ TruthRenderOutput truth_scene(const Scene& scene, const TruthOptions& o) {
   in.camera = camera;
   AxialFrame frame;
   if (scene.axial) {
+    // The truth traces the map's voxelization, which has no deformations:
+    // refused rather than silently tracing another nebula.
+    if (scene.axial->colour_deform.on || scene.axial->shape_deform.on)
+      throw ParameterError(scene.path + ": axial." +
+                               (scene.axial->colour_deform.on ? "colour_deform" : "shape_deform"),
+                           "the path tracer traces the undeformed map; deformations are for `nebula render`");
     frame = axial_frame(scene, o.axial_voxels);
     in.density = &frame.density;
     for (size_t b = 0; b < sb.bands.size(); ++b)

@@ -55,6 +55,19 @@ CameraSettings scene_camera_defaults();
 // map M(x, r) rotated about an axis, given instead of [density]. The scene
 // holds where the map comes from; the pipeline builds it
 // (pipeline/axial_map_source.h) and renders it with axial/axial_renderer.h.
+// A deformation's noise ([axial.colour_deform] or [axial.shape_deform],
+// docs/scene.md; axial/axial_deform.h). Present in the file: on.
+struct AxialNoiseSpec {
+  bool on = false;
+  std::string kind = "fbm";   // simplex, fbm, turbulence, cellular
+  double frequency = 4.0;     // features per map length
+  int octaves = 4;            // 1 to 8 (fbm, turbulence, cellular)
+  double gain = 0.5;          // (0, 1]
+  double lacunarity = 2.0;    // >= 1
+  double amplitude = 0.5;     // colour: largest lowering [0, 1]; shape: largest pull [0, 0.9]
+  uint32_t seed = 1;
+};
+
 struct AxialSpec {
   std::string source;              // "synthetic", "file" (HDF5) or "image"
   std::string synthetic;           // bipolar, lopsided, shells, empty, full
@@ -71,6 +84,8 @@ struct AxialSpec {
   Vec3 axis{0, 0, 1};              // unit direction of +x
   std::string skip = "distance";
   double step_texels = 0.5;        // the march's step h in texels
+  AxialNoiseSpec colour_deform;    // [axial.colour_deform]: lowers emission and extinction per band
+  AxialNoiseSpec shape_deform{false, "fbm", 4.0, 4, 0.5, 2.0, 0.2, 1};  // [axial.shape_deform]: pulls samples towards the axis
 };
 
 // How the fast renderer adds light scattered between voxels (the tables hold

@@ -71,7 +71,10 @@ const std::initializer_list<std::string_view> kRenderKeys = {
     "samples_per_pixel"};
 const std::initializer_list<std::string_view> kAxialKeys = {
     "synthetic", "file", "image", "dataset", "emission_prefix", "tau_channel", "emission_channels", "nx", "nr",
-    "length_pc", "tau_scale", "emission_scale", "origin", "axis", "skip", "step_texels"};
+    "length_pc", "tau_scale", "emission_scale", "origin", "axis", "skip", "step_texels", "colour_deform",
+    "shape_deform"};
+const std::initializer_list<std::string_view> kAxialNoiseKeys = {"kind",       "frequency", "octaves", "gain",
+                                                                 "lacunarity", "amplitude", "seed"};
 const std::initializer_list<std::string_view> kDensityKeys = {
     "file", "dataset", "fits", "voxel_size_pc", "procedural", "scale"};
 const std::initializer_list<std::string_view> kProceduralKeys = {
@@ -262,6 +265,7 @@ class Parser {
   std::optional<SpectralSpec> parse_spectral(const toml::table& root) const;
   DensityPlan parse_density(const toml::table& root) const;
   AxialSpec parse_axial(const toml::table& root, const std::vector<std::string>& bands) const;
+  void parse_axial_noise(const toml::table& axial, const char* name, bool shape, AxialNoiseSpec& out) const;
   ProceduralParams parse_procedural(const toml::table& t, const std::string& key) const;
   std::optional<EmissionPlan> parse_emission(const toml::table& root) const;
   DustParams parse_dust(const toml::table& root, const std::vector<std::string>& bands) const;
@@ -531,10 +535,10 @@ AxialSpec Parser::parse_axial(const toml::table& root, const std::vector<std::st
   only("nr", "synthetic");
   if (a.source == "synthetic") {
     a.synthetic = string(*t.get("synthetic"), "axial.synthetic");
-    const char* names[] = {"bipolar", "lopsided", "shells", "empty", "full"};
+    const char* names[] = {"bipolar", "lopsided", "shells", "empty", "full", "cloud"};
     if (std::find_if(std::begin(names), std::end(names), [&](const char* n) { return a.synthetic == n; }) ==
         std::end(names))
-      fail("axial.synthetic", "'" + a.synthetic + "' is not a built-in map (known: bipolar, lopsided, shells, empty, full)");
+      fail("axial.synthetic", "'" + a.synthetic + "' is not a built-in map (known: bipolar, lopsided, shells, empty, full, cloud)");
     for (const char* key : {"nx", "nr"})
       if (const toml::node* v = t.get(key)) {
         const int n = small_integer(*v, std::string("axial.") + key);
@@ -587,12 +591,60 @@ AxialSpec Parser::parse_axial(const toml::table& root, const std::vector<std::st
   }
   if (const toml::node* v = t.get("skip")) {
     a.skip = string(*v, "axial.skip");
-    const char* modes[] = {"naive", "empty", "global_max", "omega", "omega_multi", "distance"};
+    const char* modes[] = {"naive",    "empty",           "global_max",         "omega",
+                           "omega_multi", "distance",     "thesis_omega_max",   "thesis_omega_large",
+                           "thesis_omega_multi"};
     if (std::find_if(std::begin(modes), std::end(modes), [&](const char* m) { return a.skip == m; }) == std::end(modes))
-      fail("axial.skip",
-           "'" + a.skip + "' is not a skip mode (known: naive, empty, global_max, omega, omega_multi, distance)");
+      fail("axial.skip", "'" + a.skip +
+                             "' is not a skip mode (known: naive, empty, global_max, omega, omega_multi, distance, "
+                             "thesis_omega_max, thesis_omega_large, thesis_omega_multi)");
   }
+  parse_axial_noise(t, "colour_deform", false, a.colour_deform);
+  parse_axial_noise(t, "shape_deform", true, a.shape_deform);
   return a;
+}
+
+// [axial.colour_deform] / [axial.shape_deform]: the table's presence turns
+// the deformation on; each key checked against axial/axial_deform.h's ranges.
+void Parser::parse_axial_noise(const toml::table& axial, const char* name, bool shape, AxialNoiseSpec& n) const {
+  const toml::node* node = axial.get(name);
+  if (node == nullptr) return;
+  const std::string key = std::string("axial.") + name;
+  const toml::table& t = table_at(*node, key);
+  known_keys(t, key, kAxialNoiseKeys);
+  n.on = true;
+  if (const toml::node* v = t.get("kind")) {
+    n.kind = string(*v, key + ".kind");
+    if (n.kind != "simplex" && n.kind != "fbm" && n.kind != "turbulence" && n.kind != "cellular")
+      fail(key + ".kind", "'" + n.kind + "' is not a noise kind (known: simplex, fbm, turbulence, cellular)");
+  }
+  auto real = [&](const char* k, double& out) {
+    if (const toml::node* v = t.get(k)) out = number(*v, key + "." + k);
+  };
+  real("frequency", n.frequency);
+  real("gain", n.gain);
+  real("lacunarity", n.lacunarity);
+  real("amplitude", n.amplitude);
+  if (!(n.frequency > 0) || n.frequency > 1e6)
+    fail(key + ".frequency", "is " + number_text(n.frequency) + "; must be > 0 (and at most 1e6 per map length)");
+  if (!(n.gain > 0 && n.gain <= 1)) fail(key + ".gain", "is " + number_text(n.gain) + "; must be in (0, 1]");
+  if (!(n.lacunarity >= 1) || n.lacunarity > 16)
+    fail(key + ".lacunarity", "is " + number_text(n.lacunarity) + "; must be 1 to 16");
+  const double top = shape ? 0.9 : 1.0;
+  if (!(n.amplitude >= 0 && n.amplitude <= top))
+    fail(key + ".amplitude", "is " + number_text(n.amplitude) + "; must be in [0, " + (shape ? "0.9" : "1") + "]" +
+                                 (shape ? " (the largest pull towards the axis, a fraction of the distance)"
+                                        : " (the largest lowering of emission and extinction)"));
+  if (const toml::node* v = t.get("octaves")) {
+    n.octaves = small_integer(*v, key + ".octaves");
+    if (n.octaves < 1 || n.octaves > 8) fail(key + ".octaves", "is " + std::to_string(n.octaves) + "; must be 1 to 8");
+  }
+  if (const toml::node* v = t.get("seed")) {
+    const int64_t seed = integer(*v, key + ".seed");
+    if (seed < 0 || seed > 4294967295LL)
+      fail(key + ".seed", "is " + std::to_string(seed) + "; must be 0 to 4294967295");
+    n.seed = static_cast<uint32_t>(seed);
+  }
 }
 
 std::optional<EmissionPlan> Parser::parse_emission(const toml::table& root) const {

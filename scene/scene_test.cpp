@@ -710,6 +710,60 @@ TEST_F(AxialSceneFile, RefusesBadKeys) {
   refused("override", kAxial, {"axial.step_texels", "override"}, {"axial.step_texels=-1"});
 }
 
+// Deformations (docs/scene.md, [axial.colour_deform] / [axial.shape_deform]):
+// loaded key by key, off when absent, bad values refused naming the key, and
+// the resolved scene (written into every output's metadata) carries them so
+// that loading it again gives the same settings.
+TEST_F(AxialSceneFile, DeformationsLoadValidateAndSaveBack) {
+  const Scene plain = load_scene(write_text("plain.toml", kAxial));
+  EXPECT_FALSE(plain.axial->colour_deform.on);
+  EXPECT_FALSE(plain.axial->shape_deform.on);
+  const std::string deform =
+      "\n[axial.colour_deform]\nkind = \"cellular\"\nfrequency = 6.5\noctaves = 3\ngain = 0.4\nlacunarity = 2.5\n"
+      "amplitude = 0.7\nseed = 42\n[axial.shape_deform]\nkind = \"turbulence\"\namplitude = 0.3\n";
+  const std::string text = axial_edited("axis = [0.0, 0.0, 2.0]\n", "axis = [0.0, 0.0, 2.0]\n" + deform);
+  const Scene s = load_scene(write_text("deform.toml", text));
+  const AxialNoiseSpec& c = s.axial->colour_deform;
+  EXPECT_TRUE(c.on);
+  EXPECT_EQ(c.kind, "cellular");
+  EXPECT_EQ(c.frequency, 6.5);
+  EXPECT_EQ(c.octaves, 3);
+  EXPECT_EQ(c.gain, 0.4);
+  EXPECT_EQ(c.lacunarity, 2.5);
+  EXPECT_EQ(c.amplitude, 0.7);
+  EXPECT_EQ(c.seed, 42u);
+  EXPECT_TRUE(s.axial->shape_deform.on);
+  EXPECT_EQ(s.axial->shape_deform.kind, "turbulence");
+  EXPECT_EQ(s.axial->shape_deform.amplitude, 0.3);
+  EXPECT_EQ(s.axial->shape_deform.frequency, 4.0);  // the default
+  // Saved back: the resolved scene holds the tables and loads to the same settings.
+  EXPECT_NE(s.resolved_toml.find("colour_deform"), std::string::npos);
+  const Scene again = load_scene(write_text("again.toml", s.resolved_toml));
+  EXPECT_EQ(again.axial->colour_deform.kind, "cellular");
+  EXPECT_EQ(again.axial->colour_deform.seed, 42u);
+  EXPECT_EQ(again.axial->colour_deform.lacunarity, 2.5);
+  EXPECT_EQ(again.axial->shape_deform.amplitude, 0.3);
+  // Overrides reach the keys and are resolved too.
+  const Scene o = load_scene(path("deform.toml"), {"axial.shape_deform.frequency=9"});
+  EXPECT_EQ(o.axial->shape_deform.frequency, 9.0);
+  EXPECT_NE(o.resolved_toml.find("frequency = 9"), std::string::npos) << o.resolved_toml;
+  auto bad = [&](const std::string& from, const std::string& to, std::vector<std::string> pieces) {
+    std::string t = text;
+    const size_t at = t.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    t.replace(at, from.size(), to);
+    refused("bad", t, pieces);
+  };
+  bad("frequency = 6.5", "frequency = -2", {"axial.colour_deform.frequency", "is -2", "must be > 0"});
+  bad("octaves = 3", "octaves = 0", {"axial.colour_deform.octaves", "1 to 8"});
+  bad("gain = 0.4", "gain = 0", {"axial.colour_deform.gain", "(0, 1]"});
+  bad("lacunarity = 2.5", "lacunarity = 0.5", {"axial.colour_deform.lacunarity"});
+  bad("seed = 42", "seed = -1", {"axial.colour_deform.seed"});
+  bad("\"cellular\"", "\"perlin\"", {"axial.colour_deform.kind", "'perlin'", "turbulence"});
+  bad("amplitude = 0.3", "amplitude = 0.95", {"axial.shape_deform.amplitude", "[0, 0.9]"});
+  bad("amplitude = 0.3", "amplitude = 0.3\nwarp = 1", {"axial.shape_deform.warp", "unknown key"});
+}
+
 // Issue 17, item 7: a scene with both [axial] and [density] in the file names
 // no override, even when an unrelated axial key was overridden; an override
 // that made the conflicting table is named.

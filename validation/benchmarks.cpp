@@ -314,7 +314,7 @@ TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int 
 void bench_axial(Backend backend, int map_size, int width, int height, int repeats, float step_texels,
                  const std::vector<std::string>& maps, const std::vector<int>& inclinations, bool star,
                  const std::function<void(const AxialBenchRow&)>& on_row, bool step_aside,
-                 std::vector<AxialSkip> modes, bool diffuse) {
+                 std::vector<AxialSkip> modes, bool diffuse, const std::vector<AxialDeformSettings>& deforms) {
   if (modes.empty()) modes = axial_skip_modes();
   modes.erase(std::remove(modes.begin(), modes.end(), AxialSkip::Naive), modes.end());
   modes.insert(modes.begin(), AxialSkip::Naive);
@@ -358,7 +358,10 @@ void bench_axial(Backend backend, int map_size, int width, int height, int repea
     }
     in.step = step_texels * texel;
     in.step_aside = step_aside;
+    const double empty_fraction = double(map.empty_texels) / double(map.count());
+    for (const AxialDeformSettings& deform : deforms)
     for (int inc : inclinations) {
+      in.deform = deform;
       const double i = inc * kPiD / 180.0;
       CameraSettings cs;
       cs.projection = Projection::Orthographic;
@@ -394,6 +397,8 @@ void bench_axial(Backend backend, int map_size, int width, int height, int repea
         row.samples = stats.samples;
         row.diffuse_bake_ms = bake_ms;
         row.ran = to_string(stats.skip_used);
+        row.deformed = deform.any();
+        row.empty_fraction = empty_fraction;
         if (mode == AxialSkip::Naive) {
           naive = image;
           naive_ms = row.median_ms;
@@ -409,6 +414,16 @@ void bench_axial(Backend backend, int map_size, int width, int height, int repea
       }
     }
   }
+}
+
+AxialDeformSettings bench_axial_deformations(NoiseKind kind) {
+  AxialDeformSettings d;
+  d.colour = d.shape = true;
+  d.colour_noise.kind = d.shape_noise.kind = kind;
+  d.colour_noise.amplitude = 0.5f;
+  d.shape_noise.amplitude = 0.2f;
+  d.shape_noise.seed = 2;
+  return d;
 }
 
 }  // namespace nebula

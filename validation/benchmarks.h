@@ -135,6 +135,8 @@ struct AxialBenchRow {
   double max_difference = 0;  // largest |pixel - naive pixel| over naive's peak (0: bit-identical)
   uint64_t samples = 0;       // samples the rays stepped through (CPU only; 0 on the GPU)
   double diffuse_bake_ms = 0; // the map's diffuse field, baked once per map (with `diffuse`; 0 without)
+  bool deformed = false;      // with the colour and shape deformations (the naive reference deformed alike)
+  double empty_fraction = 0;  // the map's empty texels over all its texels
 };
 
 // The thesis' Tables 5.1-5.5 (Khalass 2021): each synthetic map of
@@ -148,10 +150,17 @@ struct AxialBenchRow {
 // step_aside false runs the skip code even on maps without empty texels (to
 // measure its overhead there). `diffuse` (with a star) adds the map's diffuse
 // field (axial/axial_diffuse.h: degree 3, 64 cells, 2^20 photons per band),
-// baked once per map.
+// baked once per map. Each of `deforms` (default: none) runs every mode again,
+// the naive march under the same deformations as its reference.
 void bench_axial(Backend backend, int map_size, int width, int height, int repeats, float step_texels,
                  const std::vector<std::string>& maps, const std::vector<int>& inclinations, bool star,
                  const std::function<void(const AxialBenchRow&)>& on_row, bool step_aside = true,
-                 std::vector<AxialSkip> modes = {}, bool diffuse = false);
+                 std::vector<AxialSkip> modes = {}, bool diffuse = false,
+                 const std::vector<AxialDeformSettings>& deforms = {AxialDeformSettings{}});
+
+// The deformations `nebula bench axial` times (the thesis' "with deformations"
+// columns do not state theirs): colour and shape noise of `kind`, colour
+// amplitude 0.5, shape pull up to 0.2, frequency 4 per map length, 4 octaves.
+AxialDeformSettings bench_axial_deformations(NoiseKind kind);
 
 }  // namespace nebula

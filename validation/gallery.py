@@ -20,6 +20,11 @@ voxels (`--set render.multiple_scattering=none`), with 1, 2 and 3 levels of the
 --study axial (Khalass 2021): scenes/axial_bipolar.toml, the thin bipolar
 map lit by a star at its waist, seen along the axis, at 60 degrees and
 across it, then the shells and the lopsided map at 60 degrees (no truth).
+--study axial_deform (Khalass 2021 section 3.2): the lopsided (Calabash-like)
+map, its render at 60 degrees without deformations and with colour and shape
+deformations of each noise kind (simplex, fbm, turbulence, cellular), single
+scattering (render.multiple_scattering = "none"); the map itself (tau_v,
+written by `nebula bench axial --write-maps`) first.
 --study axial_ms: validation/scenes/axial_lopsided_thick.toml (an axial map,
 optical depths up to about 5 from the star on its axis) without light
 scattered between texels and with the diffuse field (the default), beside
@@ -31,7 +36,7 @@ so brightness and colour compare directly. Writes each image as HDF5 (the
 data, which compare reads) and PNG into --renders, and the montage into --out.
 --no-truth leaves the truth out (quick looks; the montage is the fast row).
 
-Usage: /usr/bin/python3 validation/gallery.py [--study fig12|pyramid|axial|axial_ms]
+Usage: /usr/bin/python3 validation/gallery.py [--study fig12|pyramid|axial|axial_deform|axial_ms]
            [--nebula build/bin/nebula] [--scene SCENE (default: the study's)]
            [--out docs/images] [--renders out/gallery] [--size 384]
            [--truth-spp 256 | --no-truth] [--backend auto]
@@ -80,6 +85,18 @@ STUDIES = {
         ("across", "bipolar, across the axis", ["--set", "camera.position=[6.0, 0.0, 0.0]"]),
         ("shells", "shells, 60 degrees", ["--set", 'axial.synthetic="shells"']),
         ("lopsided", "lopsided, 60 degrees", ["--set", 'axial.synthetic="lopsided"']),
+    ]),
+    "axial_deform": ("axial_deform.png",
+                     "Asymmetry (after Khalass 2021, section 3.2): the lopsided map, plain and deformed (60 degrees)",
+                     AXIAL_SCENE, None, [
+        ("plain", "no deformation", []),
+    ] + [
+        (kind, f"{kind}: colour 0.8,\nshape pull up to 0.4",
+         ["--set", f'axial.colour_deform.kind="{kind}"', "--set", "axial.colour_deform.amplitude=0.8",
+          "--set", "axial.colour_deform.frequency=6",
+          "--set", f'axial.shape_deform.kind="{kind}"', "--set", "axial.shape_deform.amplitude=0.4",
+          "--set", "axial.shape_deform.frequency=8"])
+        for kind in ("simplex", "fbm", "turbulence", "cellular")
     ]),
     "axial_ms": ("axial_diffuse.png",
                  "An axial map, a = g = 0.6, optical depths up to about 5 from the star:\n"
@@ -207,6 +224,27 @@ def main():
         return h5, png
 
     shared_truth = render_truth("truth", []) if truth_mode == "shared" else None
+    map_png = None
+    if args.study == "axial_deform":
+        # A square 512^2 lopsided map 4 pc long centred on the star, seen from 12 pc; the map panel is
+        # the same synthetic map as the benchmark writes it (its tau_v; the scene scales it by tau_scale).
+        common = ["--set", 'axial.synthetic="lopsided"', "--set", "axial.nx=512", "--set", "axial.nr=512",
+                  "--set", "axial.length_pc=4.0", "--set", "axial.origin=[0.0, 0.0, -2.0]",
+                  "--set", "axial.emission_scale=0.05",
+                  "--set", "camera.position=[10.392, 0.0, 6.0]", "--set", "camera.fov_deg=22",
+                  "--set", 'render.multiple_scattering="none"']  # single scattering: the shapes show, quickly
+        variants = [(k, t, common + extra) for k, t, extra in variants]
+        run([args.nebula, "bench", "axial", "--backend", "cpu", "--maps", "lopsided", "--map-size", "512",
+             "--image", "8", "--inclinations", "0", "--modes", "naive", "--repeats", "1", "--deform", "off",
+             "--emission-only", "--write-maps", args.renders], "writing the map")
+        import h5py
+        import numpy as np
+        with h5py.File(os.path.join(args.renders, "lopsided.h5"), "r") as f:
+            tau = f["image"][()][0].astype(np.float64)  # band tau_v, [row][column], the axis at the bottom
+        map_png = os.path.join(args.renders, "axial_deform_map.png")
+        shown = np.sqrt(tau / max(tau.max(), 1e-30))
+        plt.imsave(map_png + ".tmp.png", shown, cmap="magma", vmin=0.0, vmax=1.0)
+        os.replace(map_png + ".tmp.png", map_png)
     # (title, fast PNG, truth PNG or None, caption or None) per variant
     panels = []
     for key, title, extra in variants:
@@ -222,6 +260,8 @@ def main():
                                           f"comparing {key} with the truth"))["bands"])
             print(f"  {key}: {text.replace(chr(10), ' ')}", flush=True)
         panels.append((title, png, truth[1] if truth_mode == "each" else None, text))
+    if map_png:
+        panels.insert(0, ("the map: sqrt(tau_v / max)\nx along the axis, r up", map_png, None, None))
 
     w = 3.2  # inches per panel
     if truth_mode == "each":
@@ -252,7 +292,7 @@ def main():
         elif args.study == "fig12":
             axes[0].set_ylabel(FAST_LABEL, fontsize=10)
     fig.suptitle(suptitle)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, 0.9) if args.study == "axial_deform" else None)
     montage = os.path.join(args.out, montage_name)
     fig.savefig(montage + ".tmp.png")
     os.replace(montage + ".tmp.png", montage)
