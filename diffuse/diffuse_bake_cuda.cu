@@ -1,16 +1,16 @@
-// CUDA launch of the diffuse bake: the grid and majorant uploaded once for
-// every band's photon pass, one thread per photon running the shared
+// CUDA launch of the diffuse bake: the grid uploaded once (its device
+// mirror) for every band's photon pass, one thread per photon running the shared
 // trace_diffuse_photon, 64-bit integer atomics for the fixed-point sums
 // (their order does not change them), then the harmonics made from the sums
 // on the device, where the marchers read them (DiffuseField::device_packed).
 #include <cuda_runtime.h>
 
-#include <map>
 #include <memory>
 
 #include "core/cuda_check.h"
 #include "core/cuda_timer.h"
 #include "core/device_array.h"
+#include "core/device_placement.h"
 #include "diffuse/diffuse_bake.h"
 
 namespace nebula {
@@ -43,36 +43,6 @@ __global__ void coefficients_kernel(const unsigned long long* sums, GridShape ce
   if (i % size_t(n_coeffs) == 0) l0[cell] = sums[i];
 }
 
-// A device placement that uploads each host array once however many passes
-// place it (the grid and majorant are the same for every band).
-class SharedUploads {
- public:
-  template <class T>
-  const T* place(const std::vector<T>& v) {
-    auto found = held_.find(v.data());
-    if (found != held_.end()) return static_cast<const T*>(found->second.second);
-    auto array = std::make_shared<DeviceArray<T>>(v);
-    bytes_ += array->bytes();
-    held_[v.data()] = {array, array->get()};
-    return array->get();
-  }
-  template <class T>
-  const T* place(const std::vector<T>& v, DeviceMirror& mirror) {
-    const DeviceMirror::Copy copy = mirror.get_or_upload(v.size() * sizeof(T), [&] {
-      auto array = std::make_shared<DeviceArray<T>>(v);
-      return DeviceMirror::Copy{array, array->get()};
-    });
-    bytes_ += v.size() * sizeof(T);
-    held_[v.data()] = {copy.owner, copy.device};
-    return static_cast<const T*>(copy.device);
-  }
-  size_t bytes() const { return bytes_; }
-
- private:
-  std::map<const void*, std::pair<std::shared_ptr<const void>, const void*>> held_;
-  size_t bytes_ = 0;
-};
-
 }  // namespace
 
 std::vector<DiffusePassResult> diffuse_passes_cuda(const std::vector<DiffusePassInputs>& passes,
@@ -83,7 +53,10 @@ std::vector<DiffusePassResult> diffuse_passes_cuda(const std::vector<DiffusePass
   const GridShape cells = field->cells;
   const int n_coeffs = field->n_coeffs();
   const size_t harmonics = cells.count() * size_t(n_coeffs);
-  SharedUploads device;
+  // One placement for every pass: the grid comes from its device mirror
+  // (uploaded once), the majorant and the stars (small) per pass.
+  DevicePlacement device;
+  size_t scene_bytes = 0;
   DeviceArray<unsigned long long> sums(harmonics), odd(cells.count()), l0(cells.count()), counters(4);
   auto packed = std::make_shared<DeviceArray<float>>(harmonics * 4);  // zeros: bands without a field
   int sms = 0;
@@ -94,6 +67,7 @@ std::vector<DiffusePassResult> diffuse_passes_cuda(const std::vector<DiffusePass
   for (size_t p = 0; p < passes.size(); ++p) {
     const DiffusePassInputs& in = passes[p];
     const DiffusePhotonScene scene = assemble_photon_scene(in, device);
+    if (p == 0) scene_bytes = device.bytes();  // what one pass reads (later passes place the same)
     if (p > 0) {
       NEBULA_CUDA_CHECK(cudaMemset(sums.get(), 0, sums.bytes()));
       NEBULA_CUDA_CHECK(cudaMemset(odd.get(), 0, odd.bytes()));
@@ -118,7 +92,7 @@ std::vector<DiffusePassResult> diffuse_passes_cuda(const std::vector<DiffusePass
     r.counters.tentative = c[1];
     r.counters.crossings = c[2];
     r.counters.capped = c[3];
-    r.device_bytes = device.bytes() + sums.bytes() + odd.bytes() + l0.bytes() + packed->bytes();
+    r.device_bytes = scene_bytes + sums.bytes() + odd.bytes() + l0.bytes() + packed->bytes();
     out.push_back(std::move(r));
   }
   const size_t bytes = packed->bytes();

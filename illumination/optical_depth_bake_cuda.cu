@@ -7,6 +7,7 @@
 #include "core/cuda_check.h"
 #include "core/cuda_timer.h"
 #include "core/device_array.h"
+#include "core/device_placement.h"
 #include "illumination/optical_depth_bake.h"
 
 namespace nebula {
@@ -26,11 +27,8 @@ __global__ void bake_kernel(DensityView grid, Vec3 star, float* depth) {
 BakeResult bake_star_depths_cuda(const DensityGrid& grid, const std::vector<Vec3>& stars) {
   const GridShape& g = grid.shape;
   // The grid's device copy, uploaded once for this bake, the renders and the diffuse bake.
-  const DeviceMirror::Copy tau = grid.device_tau_v.get_or_upload(grid.tau_v.size() * sizeof(float), [&] {
-    auto array = std::make_shared<DeviceArray<float>>(grid.tau_v);
-    return DeviceMirror::Copy{array, array->get()};
-  });
-  const DensityView view{g, static_cast<const float*>(tau.device)};
+  DevicePlacement device;
+  const DensityView view{g, device.place(grid.tau_v, grid.device_tau_v)};
   std::vector<std::shared_ptr<DeviceArray<float>>> depth;
   for (size_t s = 0; s < stars.size(); ++s) depth.push_back(std::make_shared<DeviceArray<float>>(g.count()));
   const dim3 block(32, 8), blocks((g.nx + 31) / 32, (g.ny + 7) / 8, g.nz);
