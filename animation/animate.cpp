@@ -15,6 +15,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/frame_pool.h"
 #include "core/progress.h"
 #include "imageio/image_output.h"
 
@@ -200,6 +201,7 @@ AnimateResult animate(const Scene& scene, const AnimateOptions& o) {
       frame.metadata.entries.push_back({"frame_time_s", plan.time(k)});
       const auto t1 = std::chrono::steady_clock::now();
       write_image(frame.image, file, frame.metadata, true);
+      recycle_frame_image(std::move(frame.image));  // the next frame's memory
       undo.armed = false;
       result.write_seconds += seconds_since(t1);
       ++result.rendered;

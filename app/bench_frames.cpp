@@ -12,6 +12,7 @@
 
 #include "app/cli_support.h"
 #include "core/error.h"
+#include "core/frame_pool.h"
 #include "core/gpu.h"
 #include "pipeline/render_scene.h"
 #include "scene/scene_file.h"
@@ -89,8 +90,9 @@ void add_animate_bench(CLI::App* bench) {
       for (int i = 0; i < o->repeats; ++i) {
         const CameraSettings camera = on_path(scene, 10.0 * (i + 1) / (o->repeats + 1));
         const auto t1 = Clock::now();
-        render_prepared(prepared, camera);
+        RenderOutput frame = render_prepared(prepared, camera);
         frames.push_back(seconds_since(t1));
+        recycle_frame_image(std::move(frame.image));  // as `nebula animate` does once a frame is written
       }
       // The baseline: what a frame cost when each render baked again (render_scene).
       Scene moved = scene;
@@ -154,6 +156,17 @@ void add_viewer_bench(CLI::App* bench) {
         session.take_frame();
       }
       if (!session.status().error.empty()) throw Error("bench viewer: " + session.status().error);
+      {
+        // Where the last edit's time went (its report): the bake's parts, then the frame.
+        const viewer::SessionStatus st = session.status();
+        double tables = 0;
+        for (const TableReport& t : st.report.tables) tables += t.seconds;
+        std::printf("| %s edit, the last: bake %.1f ms (scene load and prepare_grid) = star depths %.1f ms%s + "
+                    "tables %.1f ms + diffuse field %.1f ms (photon passes %.1f ms) + rest; frame %.1f ms |\n",
+                    to_string(b), st.bake_seconds * 1e3, st.report.bake.seconds * 1e3,
+                    st.report.bake.reused ? " (reused)" : "", tables * 1e3, st.report.diffuse.wall_seconds * 1e3,
+                    st.report.diffuse.seconds * 1e3, st.frame_seconds * 1e3);
+      }
       std::printf("| %s | %s | %d^3 | %dx%d | %.2f | %.1f | %.1f | %.3f |\n", to_string(b), device_name(b).c_str(),
                   o->size, o->width, o->height, median(views) * 1e3, 1.0 / median(views), median(edits) * 1e3, first);
       // The window's GPU frame: render and tone map into device memory (the OpenGL pixel buffer's

@@ -10,6 +10,7 @@
 #include "core/cuda_timer.h"
 #include "core/device_array.h"
 #include "core/device_placement.h"
+#include "core/frame_pool.h"
 #include "raycast/diffuse_light.h"
 #include "raycast/march_scene.h"
 #include "raycast/renderer.h"
@@ -103,7 +104,8 @@ double render_cuda_to_device(const RenderInputs& in, float* pixels, unsigned lon
 }
 
 Image render_cuda(const RenderInputs& in, RenderStats* stats) {
-  Image image(in.camera.width, in.camera.height, band_names(in.bands));
+  // Every pixel is downloaded below: the memory of a recycled frame will do.
+  Image image = take_frame_image(in.camera.width, in.camera.height, band_names(in.bands));
   // Pixels a camera does not see (outside a fisheye's circle) stay 0: cleared each frame.
   float* pixels = reused(frame_buffers.pixels, image.pixels.size());
   unsigned long long* clamps = reused(frame_buffers.clamps, 1);
