@@ -42,6 +42,10 @@ struct MarchScene {
   // (null where the band has no field): raycast/diffuse_light.h fills it
   // before the march.
   const float* diffuse_light[kMaxBands] = {};
+  // The preview (MarchMode::voxel_sources): all the light each voxel sends
+  // towards this view's eye, per band, filled before the march by
+  // raycast/voxel_sources.h; the march then only carries it to the eye.
+  const float* voxel_source[kMaxBands] = {};
 };
 
 struct RayResult {
@@ -140,6 +144,11 @@ NEBULA_HD float sample_field(const GridShape& g, const float* f, Vec3 pos, bool 
 struct MarchMode {
   float step_voxels = 0.0f;  // 0: exact traversal
   bool trilinear = true;     // smooth mode: trilinear fields, else the voxel's value
+  // The interactive preview: the exact traversal, but each voxel's light
+  // towards the eye taken once per view at the voxel's centre
+  // (raycast/voxel_sources.h) instead of over every ray's chord. Overrides
+  // step_voxels. Its error against the exact frame: docs/marcher.md.
+  bool voxel_sources = false;
 };
 
 // Marches from `origin` along unit `dir` through the whole grid. In both
@@ -150,8 +159,11 @@ struct MarchMode {
 // kDiffuse: the scene has a diffuse field, its light per voxel already
 // evaluated for this view (raycast/diffuse_light.h): it adds to the voxel's
 // source as emission does, and its forward peak to the voxel's transmittance.
-template <bool kSmooth, bool kDiffuse>
+// kVoxelSources: the preview, each voxel's light read from s.voxel_source
+// (exact traversal only).
+template <bool kSmooth, bool kDiffuse, bool kVoxelSources = false>
 NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchMode mode) {
+  static_assert(!(kSmooth && kVoxelSources), "the preview's voxel sources go with the exact traversal");
   RayResult out{};
   for (int b = 0; b < kMaxBands; ++b) out.transmittance[b] = 1.0f;
   const GridShape& g = s.density.shape;
@@ -203,6 +215,17 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchM
         }
         for (int b = 0; b < s.n_bands; ++b) source[b] += local[b] * step / fmaxf(chord, 1e-30f);
       }
+    } else if constexpr (kVoxelSources) {
+      NEBULA_UNROLL
+      for (int b = 0; b < kMaxBands; ++b)
+        if (b < s.n_bands) source[b] = s.voxel_source[b][cell];
+      if constexpr (kDiffuse) {
+        if (tau_v > 0.0f) {
+          NEBULA_UNROLL
+          for (int b = 0; b < kMaxBands; ++b)
+            if (b < s.n_bands && s.diffuse.has[b]) peak[b] = s.diffuse.peak(b, s.albedo[b] * tau_v * s.extinction_ratio[b]);
+        }
+      }
     } else {
       NEBULA_UNROLL
       for (int b = 0; b < kMaxBands; ++b)
@@ -242,15 +265,18 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchM
   return out;
 }
 
-// Calls f(smooth, diffuse) with std::bool_constant values: the one place that
+// Calls f(smooth, diffuse, voxel_sources) with std::bool_constant values: the one place that
 // turns the scene's mode into march_ray's template arguments, for the CPU loop
 // and the CUDA launch. The exact traversal, the smooth mode and the diffuse
 // field's terms are compiled apart, so the reference path carries none of the
-// others' code (registers, branches).
+// others' code (registers, branches). The preview's voxel sources go with
+// the exact traversal.
 template <class F>
 decltype(auto) dispatch_march(const MarchScene& s, MarchMode mode, F&& f) {
   auto with_smooth = [&](auto diffuse) -> decltype(auto) {
-    return mode.step_voxels > 0.0f ? f(std::true_type{}, diffuse) : f(std::false_type{}, diffuse);
+    if (mode.voxel_sources) return f(std::false_type{}, diffuse, std::true_type{});
+    return mode.step_voxels > 0.0f ? f(std::true_type{}, diffuse, std::false_type{})
+                                   : f(std::false_type{}, diffuse, std::false_type{});
   };
   return s.has_diffuse ? with_smooth(std::true_type{}) : with_smooth(std::false_type{});
 }

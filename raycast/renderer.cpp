@@ -11,6 +11,7 @@
 #include "core/progress.h"
 #include "raycast/diffuse_light.h"
 #include "raycast/march_scene.h"
+#include "raycast/voxel_sources.h"
 
 namespace nebula {
 
@@ -49,7 +50,24 @@ Image render_cpu(const RenderInputs& in, RenderStats* stats) {
   std::atomic<uint64_t> clamps{0};
   const auto start = std::chrono::steady_clock::now();
   std::vector<std::vector<float>> light(kMaxBands);
-  if (scene.has_diffuse) {
+  if (in.mode.voxel_sources) {
+    // The preview: every voxel's light towards the eye, once (raycast/voxel_sources.h).
+    const GridShape& g = scene.density.shape;
+    VoxelSourcePlanes planes;
+    for (int b = 0; b < scene.n_bands; ++b) {
+      light[b].resize(g.count());
+      planes.band[b] = light[b].data();
+      scene.voxel_source[b] = planes.band[b];
+    }
+    dispatch_source_degree(scene, [&](auto degree) {
+      tbb::parallel_for(tbb::blocked_range<int>(0, g.ny * g.nz), [&](const auto& rows) {
+        int local = 0;
+        for (int r = rows.begin(); r != rows.end(); ++r)
+          local += voxel_source_row<degree()>(scene, in.camera, r % g.ny, r / g.ny, 0, g.nx, planes);
+        clamps += uint64_t(local);
+      });
+    });
+  } else if (scene.has_diffuse) {
     const GridShape& g = scene.density.shape;
     DiffuseLightPlanes planes;
     for (int b = 0; b < scene.n_bands; ++b)
@@ -65,14 +83,14 @@ Image render_cpu(const RenderInputs& in, RenderStats* stats) {
       });
     });
   }
-  dispatch_march(scene, in.mode, [&](auto smooth, auto diffuse) {
+  dispatch_march(scene, in.mode, [&](auto smooth, auto diffuse, auto voxel_sources) {
     tbb::parallel_for(tbb::blocked_range<int>(0, in.camera.height), [&](const auto& rows) {
       uint64_t local_clamps = 0;
       for (int y = rows.begin(); y != rows.end(); ++y)
         for (int x = 0; x < in.camera.width; ++x) {
           Vec3 origin, dir;
           if (!in.camera.ray(x, y, origin, dir)) continue;
-          const RayResult r = march_ray<smooth(), diffuse()>(scene, origin, dir, in.mode);
+          const RayResult r = march_ray<smooth(), diffuse(), voxel_sources()>(scene, origin, dir, in.mode);
           store_radiance(r, scene.n_bands, in.exposure, image.pixels.data(), image.width, image.height, x, y);
           local_clamps += r.table_clamps;
         }

@@ -14,6 +14,7 @@
 #include "raycast/diffuse_light.h"
 #include "raycast/march_scene.h"
 #include "raycast/renderer.h"
+#include "raycast/voxel_sources.h"
 
 namespace nebula {
 namespace {
@@ -39,7 +40,20 @@ __global__ void diffuse_light_kernel(MarchScene scene, Camera camera, DiffuseLig
   diffuse_light_row<kDeg>(scene, camera, y, z, x, x + 1, out);
 }
 
-template <bool kSmooth, bool kDiffuse>
+// One thread per voxel: the preview's light of each voxel towards this view's
+// eye (raycast/voxel_sources.h).
+template <int kDeg>
+__global__ void voxel_source_kernel(MarchScene scene, Camera camera, VoxelSourcePlanes out,
+                                    unsigned long long* clamps) {
+  const GridShape& g = scene.density.shape;
+  const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (i >= g.count()) return;
+  const int x = int(i % size_t(g.nx)), y = int(i / size_t(g.nx) % size_t(g.ny)), z = int(i / (size_t(g.nx) * g.ny));
+  const int n = voxel_source_row<kDeg>(scene, camera, y, z, x, x + 1, out);
+  if (n) atomicAdd(clamps, static_cast<unsigned long long>(n));
+}
+
+template <bool kSmooth, bool kDiffuse, bool kVoxelSources>
 __global__ void __launch_bounds__(256, kSmooth ? 2 : NEBULA_RENDER_MIN_BLOCKS)
     render_kernel(MarchScene scene, Camera camera, MarchMode mode, float exposure, float* pixels,
                   unsigned long long* clamps) {
@@ -48,7 +62,7 @@ __global__ void __launch_bounds__(256, kSmooth ? 2 : NEBULA_RENDER_MIN_BLOCKS)
   if (x >= camera.width || y >= camera.height) return;
   Vec3 origin, dir;
   if (!camera.ray(x, y, origin, dir)) return;
-  const RayResult r = march_ray<kSmooth, kDiffuse>(scene, origin, dir, mode);
+  const RayResult r = march_ray<kSmooth, kDiffuse, kVoxelSources>(scene, origin, dir, mode);
   store_radiance(r, scene.n_bands, exposure, pixels, camera.width, camera.height, x, y);
   if (r.table_clamps) atomicAdd(clamps, static_cast<unsigned long long>(r.table_clamps));
 }
@@ -77,27 +91,38 @@ double render_cuda_to_device(const RenderInputs& in, float* pixels, unsigned lon
   DevicePlacement device;
   MarchScene scene = assemble_march_scene(in, device);
   const dim3 block(16, 16), grid((in.camera.width + 15) / 16, (in.camera.height + 15) / 16);
-  // The diffuse field's light for this view, per band with a field (every
-  // voxel written by the kernel below).
-  DiffuseLightPlanes planes;
   const size_t count = scene.density.shape.count();
-  if (scene.has_diffuse)
+  const unsigned voxel_blocks = static_cast<unsigned>((count + 255) / 256);
+  CudaEventTimer timer;
+  if (in.mode.voxel_sources) {
+    // The preview: every voxel's light towards the eye, once (raycast/voxel_sources.h).
+    VoxelSourcePlanes sources;
+    for (int b = 0; b < scene.n_bands; ++b) {
+      sources.band[b] = reused(frame_buffers.light[b], count);
+      scene.voxel_source[b] = sources.band[b];
+    }
+    dispatch_source_degree(scene, [&](auto degree) {
+      voxel_source_kernel<degree()><<<voxel_blocks, 256>>>(scene, in.camera, sources, clamps);
+    });
+    NEBULA_CUDA_CHECK(cudaGetLastError());
+  } else if (scene.has_diffuse) {
+    // The diffuse field's light for this view, per band with a field (every
+    // voxel written by the kernel).
+    DiffuseLightPlanes planes;
     for (int b = 0; b < scene.n_bands; ++b)
       if (scene.diffuse.has[b]) {
         planes.band[b] = reused(frame_buffers.light[b], count);
         scene.diffuse_light[b] = planes.band[b];
       }
-  CudaEventTimer timer;
-  if (scene.has_diffuse) {
-    const unsigned blocks = static_cast<unsigned>((count + 255) / 256);
     dispatch_diffuse_degree(scene.diffuse.degree, [&](auto degree) {
-      diffuse_light_kernel<degree()><<<blocks, 256>>>(scene, in.camera, planes);
+      diffuse_light_kernel<degree()><<<voxel_blocks, 256>>>(scene, in.camera, planes);
     });
     NEBULA_CUDA_CHECK(cudaGetLastError());
   }
   // One kernel per mode (raycast/ray_march.h, dispatch_march).
-  dispatch_march(scene, in.mode, [&](auto smooth, auto diffuse) {
-    render_kernel<smooth(), diffuse()><<<grid, block>>>(scene, in.camera, in.mode, in.exposure, pixels, clamps);
+  dispatch_march(scene, in.mode, [&](auto smooth, auto diffuse, auto voxel_sources) {
+    render_kernel<smooth(), diffuse(), voxel_sources()>
+        <<<grid, block>>>(scene, in.camera, in.mode, in.exposure, pixels, clamps);
   });
   NEBULA_CUDA_CHECK(cudaGetLastError());
   return timer.seconds();
