@@ -4,8 +4,10 @@
 // docs/performance.md, each with its baseline measured in the same run.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -108,15 +110,45 @@ void add_animate_bench(CLI::App* bench) {
   });
 }
 
+// How far a preview is from the exact frame of the same view: the relative
+// difference of the totals, and the 95th percentile of |preview / frame - 1|
+// over pixels above 1e-3 of the frame's peak.
+struct PreviewError {
+  double total = 0, p95 = 0;
+};
+PreviewError preview_error(const Image& exact, const Image& preview) {
+  PreviewError e;
+  if (exact.pixels.size() != preview.pixels.size()) return e;
+  double sum_exact = 0, sum_preview = 0, peak = 0;
+  for (size_t i = 0; i < exact.pixels.size(); ++i) {
+    sum_exact += exact.pixels[i];
+    sum_preview += preview.pixels[i];
+    peak = std::max(peak, double(exact.pixels[i]));
+  }
+  std::vector<double> rel;
+  for (size_t i = 0; i < exact.pixels.size(); ++i)
+    if (exact.pixels[i] > 1e-3 * peak) rel.push_back(std::fabs(preview.pixels[i] / double(exact.pixels[i]) - 1.0));
+  e.total = sum_exact > 0 ? sum_preview / sum_exact - 1.0 : 0.0;
+  if (!rel.empty()) {
+    const size_t k = size_t(0.95 * double(rel.size() - 1));
+    std::nth_element(rel.begin(), rel.begin() + long(k), rel.end());
+    e.p95 = rel[k];
+  }
+  return e;
+}
+
 void add_viewer_bench(CLI::App* bench) {
   auto o = std::make_shared<Common>();
   o->width = 1280;
   o->height = 720;
+  auto coarsening = std::make_shared<int>(-1);
   CLI::App* cmd = bench->add_subcommand(
       "viewer", "the viewer's session without a window: a new view to its frame, and a slider edit (albedo) to the "
                 "re-baked frame; the hand-over to OpenGL is not included");
   add_common(cmd, *o);
-  cmd->callback([o] {
+  cmd->add_option("--preview-coarsening", *coarsening,
+                 "the preview's grid halved N times, as nebula-view's option (default: 1 on the CPU, 0 on the GPU)");
+  cmd->callback([o, coarsening] {
     const uint64_t photons = parse_count("--diffuse-photons", o->diffuse_photons, 1, 1e10);
     std::printf("| backend | device | grid | frame | view to frame ms (median of %d) | frames/s | edit to frame ms "
                 "(median of %d) | first bake s |\n|---|---|---|---|---|---|---|---|\n",
@@ -129,6 +161,7 @@ void add_viewer_bench(CLI::App* bench) {
       source.set("render.diffuse_photons", std::to_string(photons));
       viewer::ViewerOptions options;
       options.backend = b;
+      options.preview_coarsening = *coarsening >= 0 ? *coarsening : (b == Backend::Cpu ? 1 : 0);  // as nebula-view
       const auto t0 = Clock::now();
       viewer::Session session(source, options);
       const Scene& scene = session.scene();
@@ -137,7 +170,7 @@ void add_viewer_bench(CLI::App* bench) {
       session.wait_idle();
       const double first = seconds_since(t0);
       session.take_frame();
-      std::vector<double> views, edits;
+      std::vector<double> views, previews, edits, preview_total, preview_p95;
       for (int i = 0; i < o->repeats; ++i) {
         CameraSettings c = on_path(scene, 10.0 * (i + 1) / (o->repeats + 1));
         c.width = o->width;
@@ -146,7 +179,18 @@ void add_viewer_bench(CLI::App* bench) {
         session.request(c);
         session.wait_idle();
         views.push_back(seconds_since(t1));
-        session.take_frame();
+        const std::optional<viewer::Frame> exact = session.take_frame();
+        // The moving camera's preview of the same view (MarchMode::voxel_sources), and how far it is from the frame.
+        const auto t2 = Clock::now();
+        session.request(c, true);
+        session.wait_idle();
+        previews.push_back(seconds_since(t2));
+        const std::optional<viewer::Frame> quick = session.take_frame();
+        if (exact && quick) {
+          const PreviewError e = preview_error(exact->image, quick->image);
+          preview_total.push_back(e.total);
+          preview_p95.push_back(e.p95);
+        }
       }
       for (int i = 0; i < o->repeats; ++i) {
         const auto t1 = Clock::now();
@@ -169,6 +213,11 @@ void add_viewer_bench(CLI::App* bench) {
       }
       std::printf("| %s | %s | %d^3 | %dx%d | %.2f | %.1f | %.1f | %.3f |\n", to_string(b), device_name(b).c_str(),
                   o->size, o->width, o->height, median(views) * 1e3, 1.0 / median(views), median(edits) * 1e3, first);
+      std::printf("| %s preview (moving camera: voxel sources) | %s | %d^3 | %dx%d | %.2f | %.1f | total %+.2f%%, 95th "
+                  "percentile pixel %.2f%% from the frame (medians over the views) | |\n",
+                  to_string(b), device_name(b).c_str(), o->size, o->width, o->height, median(previews) * 1e3,
+                  1.0 / median(previews), preview_total.empty() ? 0.0 : 100 * median(preview_total),
+                  preview_p95.empty() ? 0.0 : 100 * median(preview_p95));
       // The window's GPU frame: render and tone map into device memory (the OpenGL pixel buffer's
       // stand-in: mapping a registered buffer needs a window, which a benchmark machine lacks).
       if (b == Backend::Cuda && viewer::GpuFrame::available()) {

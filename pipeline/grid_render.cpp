@@ -152,7 +152,49 @@ PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o, PreparedGr
   return p;
 }
 
-RenderOutput render_prepared(const PreparedGrid& p, const CameraSettings& settings) {
+Scene coarsened_scene(const Scene& scene, int levels) {
+  if (scene.axial) throw Error(scene.path + ": axial: an axial scene has no 3D grid to coarsen");
+  if (levels < 0) throw Error("coarsening by " + std::to_string(levels) + " levels: must be >= 0");
+  levels = std::min(levels, max_pyramid_levels(scene.density.shape));  // the coarsest keeps 2 voxels
+  Scene coarse = scene;
+  for (int i = 0; i < levels; ++i) {
+    const GridShape fine = coarse.density.shape;
+    coarse.density = downsample(coarse.density);
+    for (std::vector<float>& e : coarse.emission) e = downsample_edge_integral(fine, e);
+  }
+  coarse.diffuse.cells = std::max(1, scene.diffuse.cells >> levels);
+  // 8x fewer cells per level: a quarter of the photons per level still leaves
+  // each cell twice the photons (half the noise variance) of the full field's.
+  coarse.diffuse.photons = std::max<uint64_t>(4096, scene.diffuse.photons >> (2 * levels));
+  if (!coarse.grid_source.empty()) coarse.grid_source += "|coarsened " + std::to_string(levels);
+  return coarse;
+}
+
+PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o, const PreparedGrid& previous) {
+  // What is unchanged is copied (its device copies shared, not uploaded
+  // again), leaving `previous` whole: another thread may still render from it.
+  PreparedGrid donor;
+  const std::string bake = bake_key(scene, scene_bands(scene), o.backend);
+  if (bake.empty() || bake != previous.bake_key || previous.bake.tau_v.empty())
+    return prepare_grid(scene, o, std::move(donor));
+  donor.bake_key = previous.bake_key;
+  donor.bake.tau_v = previous.bake.tau_v;
+  donor.bake.seconds = previous.bake.seconds;
+  donor.bake.device_tau_v.resize(previous.bake.device_tau_v.size());
+  for (size_t k = 0; k < previous.bake.device_tau_v.size(); ++k)
+    donor.bake.device_tau_v[k].share(previous.bake.device_tau_v[k]);
+  const std::string diffuse = scene.multiple_scattering == MultipleScattering::Diffuse
+                                  ? diffuse_key(bake, scene, scene_bands(scene), o)
+                                  : "";
+  if (!diffuse.empty() && diffuse == previous.diffuse_key) {
+    donor.diffuse = previous.diffuse;  // its device copy shared
+    donor.diffuse_key = previous.diffuse_key;
+    donor.report.diffuse = previous.report.diffuse;
+  }
+  return prepare_grid(scene, o, std::move(donor));
+}
+
+RenderOutput render_prepared(const PreparedGrid& p, const CameraSettings& settings, bool preview) {
   const Scene& scene = *p.scene;
   const Camera camera = make_camera(settings);
   const int k = samples_per_pixel_side(scene.samples_per_pixel);
@@ -161,6 +203,7 @@ RenderOutput render_prepared(const PreparedGrid& p, const CameraSettings& settin
   if (in.diffuse) in.diffuse = &p.diffuse;
   in.camera = make_camera(supersampled_camera(settings, scene.samples_per_pixel));
   in.exposure = 1.0f;  // science pixels: the exposure goes in the metadata
+  in.mode.voxel_sources = preview;
   std::unique_ptr<Progress> bar;
   if (p.options.progress && p.options.backend == Backend::Cpu)
     bar = std::make_unique<Progress>("render", uint64_t(in.camera.height));
@@ -184,6 +227,7 @@ RenderOutput render_prepared(const PreparedGrid& p, const CameraSettings& settin
   out.metadata.entries.push_back({"pyramid_levels", scene.pyramid_levels});
   out.metadata.entries.push_back({"pixel_samples", scene.samples_per_pixel});
   out.metadata.entries.push_back({"multiple_scattering", multiple_scattering_text(out.report)});
+  if (preview) out.metadata.entries.push_back({"preview", "voxel sources (raycast/voxel_sources.h)"});
   return out;
 }
 

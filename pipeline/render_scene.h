@@ -93,7 +93,19 @@ PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& options);
 // from `previous` instead of being computed again; the report marks them
 // reused. Grids are compared by what they were made from (Scene::grid_source).
 PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& options, PreparedGrid&& previous);
-RenderOutput render_prepared(const PreparedGrid& prepared, const CameraSettings& camera);
+// The same leaving `previous` unchanged (it may be in use): what is reused is
+// copied on the host and shared on the device.
+PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& options, const PreparedGrid& previous);
+// The scene with its grids halved `levels` times (multires/volume_pyramid.h:
+// the dust's mass kept), the diffuse field's cells with them and a quarter of
+// its photons per level (twice the photons per cell still): a preview's
+// grid, baked on its own. grid_source says so, so its bakes never pass for
+// the full grid's. Levels beyond the grid's (the coarsest keeps 2 voxels) are
+// not made. Error for an axial scene or negative levels.
+Scene coarsened_scene(const Scene& scene, int levels);
+// preview: the interactive preview, each voxel's light towards the eye taken
+// once per view at its centre (MarchMode::voxel_sources; docs/marcher.md).
+RenderOutput render_prepared(const PreparedGrid& prepared, const CameraSettings& camera, bool preview = false);
 
 struct TruthOptions {
   Backend backend = Backend::Cpu;

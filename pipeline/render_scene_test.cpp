@@ -468,3 +468,45 @@ TEST_F(RenderScene, TheTruthTracesAnAxialMapInItsOwnFrame) {
 
 }  // namespace
 }  // namespace nebula
+
+namespace nebula {
+namespace {
+
+TEST_F(RenderScene, ACoarsenedSceneKeepsTheDustAndBakesApart) {
+  const Scene fine = scene("[render]\ndiffuse_photons = 8192\n");
+  const Scene coarse = coarsened_scene(fine, 1);
+  EXPECT_EQ(coarse.density.shape.nx, (fine.density.shape.nx + 1) / 2);
+  EXPECT_EQ(coarse.density.shape.voxel, 2 * fine.density.shape.voxel);
+  // The dust's mass: sum of tau_v l^2 over the voxels.
+  double mass_fine = 0, mass_coarse = 0;
+  for (float t : fine.density.tau_v) mass_fine += double(t) * fine.density.shape.voxel * fine.density.shape.voxel;
+  for (float t : coarse.density.tau_v)
+    mass_coarse += double(t) * coarse.density.shape.voxel * coarse.density.shape.voxel;
+  EXPECT_NEAR(mass_coarse, mass_fine, 1e-5 * mass_fine);
+  EXPECT_EQ(coarse.diffuse.cells, std::max(1, fine.diffuse.cells / 2));
+  EXPECT_EQ(coarse.diffuse.photons, std::max<uint64_t>(4096, fine.diffuse.photons / 4));
+  EXPECT_NE(coarse.grid_source, fine.grid_source);  // never mistaken for the fine grid's bakes
+  // Its own bakes: a preparation of it reuses nothing of the fine grid's.
+  const PreparedGrid p_fine = prepare_grid(fine, options());
+  const PreparedGrid p_coarse = prepare_grid(coarse, options(), p_fine);
+  EXPECT_FALSE(p_coarse.report.bake.reused);
+  EXPECT_EQ(p_coarse.bake.tau_v[0].size(), coarse.density.shape.count());
+  EXPECT_THROW(coarsened_scene(fine, -1), Error);
+  // Asking more levels than the grid has stops at a grid of 2 voxels.
+  EXPECT_EQ(coarsened_scene(fine, 30).density.shape.nx, 2);
+}
+
+TEST_F(RenderScene, APreparationLeftWholeGivesTheSameFrame) {
+  const std::string few_photons = "[render]\ndiffuse_photons = 8192\n";
+  const Scene first = scene(few_photons);
+  const PreparedGrid before = prepare_grid(first, options());
+  const Scene edited = scene(few_photons, "albedo = 0.8");
+  const PreparedGrid reused = prepare_grid(edited, options(), before);  // `before` stays whole
+  EXPECT_TRUE(reused.report.bake.reused);
+  EXPECT_FALSE(before.bake.tau_v.empty());
+  const PreparedGrid fresh = prepare_grid(edited, options());
+  EXPECT_EQ(render_prepared(reused, edited.camera).image.pixels, render_prepared(fresh, edited.camera).image.pixels);
+}
+
+}  // namespace
+}  // namespace nebula

@@ -49,6 +49,8 @@ struct Args {
   int preview_scale = 0;       // 0: 2 on the CPU, 1 on the GPU
   long long preview_photons = -1;  // -1: 65536 on the CPU, the scene's on the GPU
   bool force = false, show_panels = false;
+  bool exact_preview = false;  // moving frames marched exactly too (default: voxel sources)
+  int preview_coarsening = -1;  // -1: 1 on the CPU, 0 on the GPU
   std::string table_photons = "30000";
 };
 
@@ -232,6 +234,8 @@ int run(const Args& args) {
 
   ViewerOptions options;
   options.backend = backend;
+  if (args.preview_coarsening < -1) throw Error("--preview-coarsening: must be >= 0");
+  options.preview_coarsening = args.preview_coarsening >= 0 ? args.preview_coarsening : (backend == Backend::Cpu ? 1 : 0);
   {
     double photons = 0;
     if (!parse_number(args.table_photons, photons) || !(photons >= 1000 && photons <= 1e9) || photons != std::floor(photons))
@@ -285,7 +289,7 @@ int run(const Args& args) {
   std::optional<Frame> shown;
   Rgba8 shown_rgba;
   CameraSettings requested{};
-  bool have_request = false;
+  bool have_request = false, requested_preview = false;
   uint64_t version_seen = 0;
   auto last_motion = Clock::now() - std::chrono::seconds(10);
   char screenshot_path[512] = "nebula-view.png", scene_path[512] = "nebula-view.toml";
@@ -361,9 +365,13 @@ int run(const Args& args) {
       want.height = want.projection == Projection::Fisheye ? want.width : std::max(1, view.camera.height / preview_scale);
     }
     if (gpu_shown) want = view.camera, want.exposure = 1;  // full size: the GPU shows the moving frames
-    if (host_frames && !camera_issue(want) && (!have_request || !same_view(want, requested) || status.version != version_seen)) {
-      session.request(want);
+    // A moving camera's host frames are previews (each voxel's light once per view); at rest, exact.
+    const bool preview = moving && !gpu_shown && !args.exact_preview;
+    if (host_frames && !camera_issue(want) &&
+        (!have_request || !same_view(want, requested) || preview != requested_preview || status.version != version_seen)) {
+      session.request(want, preview);
       requested = want;
+      requested_preview = preview;
       have_request = true;
       version_seen = status.version;
     }
@@ -701,6 +709,12 @@ int main(int argc, char** argv) {
   app.add_option("--window-width", a.window_width, "window width")->capture_default_str();
   app.add_option("--window-height", a.window_height, "window height")->capture_default_str();
   app.add_option("--preview-scale", a.preview_scale, "while moving, render at 1/N of the size (default: 2 CPU, 1 GPU)");
+  app.add_flag("--exact-preview", a.exact_preview,
+               "march the moving camera's reduced frames exactly too (default: each voxel's light taken once per "
+               "view, about 4x faster on the CPU; docs/marcher.md)");
+  app.add_option("--preview-coarsening", a.preview_coarsening,
+                 "while moving, render from the grid halved N times, baked on its own (default: 1 on the CPU, 0 on "
+                 "the GPU)");
   app.add_option("--preview-photons", a.preview_photons,
                  "diffuse-field photons per band for the viewer's bakes, recorded in the scene (default: 65536 on "
                  "the CPU, the scene's on the GPU; 0: the scene's)");

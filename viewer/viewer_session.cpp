@@ -1,5 +1,6 @@
 #include "viewer/viewer_session.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -109,15 +110,31 @@ struct Session::Baked {
   std::shared_ptr<const Scene> scene;
   RenderOptions options;
   PreparedGrid prepared;  // built in place: it points into itself and into *scene
-  Baked(std::shared_ptr<const Scene> s, const RenderOptions& o)
-      : scene(std::move(s)), options(o), prepared(per_frame() ? PreparedGrid{} : prepare_grid(*scene, o)) {}
+  // After an edit, what the edit left unchanged (the star bakes after an albedo
+  // edit, say) is taken from the previous bake, which stays whole for frames
+  // still rendering from it.
+  Baked(std::shared_ptr<const Scene> s, const RenderOptions& o, const Baked* previous, int coarsening)
+      : scene(std::move(s)),
+        options(o),
+        prepared(per_frame()                              ? PreparedGrid{}
+                 : previous && !previous->per_frame() ? prepare_grid(*scene, o, previous->prepared)
+                                                          : prepare_grid(*scene, o)) {
+    // The previews' coarser grid (ViewerOptions::preview_coarsening), its bakes reused alike.
+    const bool pyramid = scene->pyramid_levels > 0 || scene->multiple_scattering == MultipleScattering::Pyramid;
+    if (per_frame() || pyramid || coarsening <= 0) return;
+    const Baked* before = previous ? previous->coarse.get() : nullptr;
+    coarse = std::make_unique<const Baked>(std::make_shared<const Scene>(coarsened_scene(*scene, coarsening)), o,
+                                           before, 0);
+  }
+  std::unique_ptr<const Baked> coarse;  // the previews' grid, or null
 
   // An axial map bakes with its render (cheap beside a 3D grid's bake); the
   // spectral renderer has no bake to keep.
   bool per_frame() const { return scene->axial.has_value() || scene->spectral.has_value(); }
 
-  RenderOutput render(const CameraSettings& camera) const {
-    if (!per_frame()) return render_prepared(prepared, camera);
+  RenderOutput render(const CameraSettings& camera, bool preview) const {
+    if (preview && coarse) return coarse->render(camera, true);
+    if (!per_frame()) return render_prepared(prepared, camera, preview);
     Scene copy = *scene;
     copy.camera = camera;
     return render_scene(copy, options);
@@ -152,10 +169,11 @@ void Session::edit(const std::string& key, const std::string& value) {
   wake_.notify_all();
 }
 
-void Session::request(const CameraSettings& camera) {
+void Session::request(const CameraSettings& camera, bool preview) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     wanted_camera_ = camera;
+    wanted_preview_ = preview;
     ++wanted_request_;
   }
   wake_.notify_all();
@@ -312,6 +330,7 @@ void Session::work() {
       const uint64_t version = wanted_version_;
       const SceneSource source = source_;
       const std::shared_ptr<const Scene> previous = latest_scene_;
+      const std::shared_ptr<const Baked> reuse = baked_;
       status_.activity = "baking (" + why_ + ")";
       status_.busy = true;
       lock.unlock();
@@ -325,7 +344,7 @@ void Session::work() {
         o.backend = options_.backend;
         o.table_photons = options_.table_photons;
         o.smooth_step = options_.smooth_step;
-        fresh = std::make_shared<Baked>(scene, o);
+        fresh = std::make_shared<Baked>(scene, o, reuse.get(), options_.preview_coarsening);
       } catch (const std::exception& e) {
         error = e.what();
       }
@@ -348,6 +367,7 @@ void Session::work() {
       baked_version_ = version;
     } else {
       const CameraSettings camera = *wanted_camera_;
+      const bool preview = wanted_preview_;
       const uint64_t request = wanted_request_;
       const uint64_t version = baked_version_;
       const std::shared_ptr<const Baked> current = baked_;
@@ -358,10 +378,11 @@ void Session::work() {
       std::string error;
       const auto t0 = std::chrono::steady_clock::now();
       try {
-        RenderOutput out = current->render(camera);
+        RenderOutput out = current->render(camera, preview);
         frame.image = std::move(out.image);
         frame.metadata = std::move(out.metadata);
         frame.camera = camera;
+        frame.preview = preview;
         frame.request = request;
         frame.version = version;
       } catch (const std::exception& e) {

@@ -58,12 +58,17 @@ struct ViewerOptions {
   Backend backend = Backend::Cpu;
   uint64_t table_photons = 30000;  // photons per row of tables generated on first use
   float smooth_step = 0;           // 0: the exact traversal
+  // Previews (Session::request with preview) come from the grid halved this
+  // many times, baked on its own after each bake of the full grid (0: the
+  // full grid). Scenes using the pyramid keep their grid.
+  int preview_coarsening = 0;
 };
 
 struct Frame {
   Image image;             // science pixels (radiance)
   ImageMetadata metadata;  // as render_prepared gives it
   CameraSettings camera;   // the view, at the size rendered
+  bool preview = false;    // the quick frame of a moving camera (Session::request)
   double seconds = 0;      // rendering it
   uint64_t request = 0;    // the request it answers
   uint64_t version = 0;    // the scene version it shows
@@ -104,7 +109,10 @@ class Session {
   // the change in the status ("dust.albedo changed"). Camera and display keys
   // belong to the front end and need no bake.
   void edit(const std::string& key, const std::string& value);
-  void request(const CameraSettings& camera);  // render this view next; a newer request replaces it
+  // Render this view next; a newer request replaces it. preview: the quick
+  // frame for a moving camera (each voxel's light taken once per view,
+  // MarchMode::voxel_sources; axial and spectral scenes render as usual).
+  void request(const CameraSettings& camera, bool preview = false);
   std::optional<Frame> take_frame();           // the newest finished frame, once
   // Ground truth: while on and nothing else is pending, the worker adds path-tracer
   // passes for the last view rendered; a new view or edit starts again.
@@ -137,6 +145,7 @@ class Session {
   uint64_t wanted_version_ = 1, baked_version_ = 0;
   std::string why_ = "the scene was opened";
   std::optional<CameraSettings> wanted_camera_;
+  bool wanted_preview_ = false;
   uint64_t wanted_request_ = 0, rendered_request_ = 0;
   bool working_ = false, stop_ = false;
   std::shared_ptr<Baked> baked_;                   // replaced by the worker only

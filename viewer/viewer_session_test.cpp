@@ -103,6 +103,47 @@ TEST_F(ViewerSession, TheSavedSceneRendersTheSameImage) {
   EXPECT_EQ(rendered.image.pixels, shown.image.pixels);
 }
 
+TEST_F(ViewerSession, AnEditKeepsTheBakesItDoesNotChange) {
+  Session s(SceneSource(kScene, "v.toml", "."), options());
+  const CameraSettings camera = s.scene().camera;
+  frame_of(s, camera);
+  EXPECT_FALSE(s.status().report.bake.reused);
+  s.edit("dust.albedo", "0.8");  // the stars' depths do not depend on the albedo
+  const Frame after_albedo = frame_of(s, camera);
+  EXPECT_TRUE(s.status().report.bake.reused);
+  EXPECT_FALSE(s.status().report.diffuse.reused);  // the field does
+  // Taken over, not approximated: the frame is the edited scene's fresh render.
+  RenderOptions o;
+  o.table_photons = 1000;
+  Scene edited = load_scene_text(kScene, "v.toml", ".", {"dust.albedo=0.8"});
+  EXPECT_EQ(render_scene(edited, o).image.pixels, after_albedo.image.pixels);
+  s.edit("stars.0.position", "[0.7, 1.0, 1.1]");  // a moved star is baked again
+  frame_of(s, camera);
+  EXPECT_FALSE(s.status().report.bake.reused);
+}
+
+TEST_F(ViewerSession, APreviewIsTheCoarserGridsQuickFrame) {
+  ViewerOptions o = options();
+  o.preview_coarsening = 1;
+  Session s(SceneSource(kScene, "v.toml", "."), o);
+  const CameraSettings camera = s.scene().camera;
+  const Frame exact = frame_of(s, camera);
+  EXPECT_FALSE(exact.preview);
+  s.request(camera, true);
+  s.wait_idle();
+  const std::optional<Frame> quick = s.take_frame();
+  ASSERT_TRUE(quick.has_value());
+  EXPECT_TRUE(quick->preview);
+  EXPECT_EQ(quick->image.width, camera.width);
+  EXPECT_NE(quick->image.pixels, exact.image.pixels);
+  // It is what the pipeline makes of the halved grid in the preview mode, bit for bit.
+  RenderOptions ro;
+  ro.table_photons = 1000;
+  const Scene coarse = coarsened_scene(load_scene_text(kScene, "v.toml", "."), 1);
+  const PreparedGrid prepared = prepare_grid(coarse, ro);
+  EXPECT_EQ(render_prepared(prepared, camera, true).image.pixels, quick->image.pixels);
+}
+
 TEST_F(ViewerSession, AStarsTemperatureReplacesItsClass) {
   Session s(SceneSource(kScene, "v.toml", "."), options());
   const CameraSettings camera = s.scene().camera;
