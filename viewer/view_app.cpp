@@ -635,7 +635,35 @@ int run(const Args& args) {
             ImGui::SliderFloat("softening", &soft, 1e-4f, 1, "%.4g", ImGuiSliderFlags_Logarithmic))
           view.display.softening = soft;
       }
-      if (scene.axial && ImGui::CollapsingHeader("Axial map", ImGuiTreeNodeFlags_DefaultOpen)) {
+      if (ImGui::CollapsingHeader("Files", ImGuiTreeNodeFlags_DefaultOpen)) {
+        ImGui::InputText("image", screenshot_path, sizeof screenshot_path);
+        if (ImGui::Button("screenshot (.png .exr .fits .h5)")) {
+          try {
+            if (!full) throw Error("no full-size frame yet: let the camera rest");
+            write_screenshot(*full, view, screenshot_path, true);
+            message = std::string("wrote ") + screenshot_path;
+          } catch (const std::exception& e) {
+            message = e.what();
+          }
+        }
+        ImGui::InputText("scene", scene_path, sizeof scene_path);
+        if (ImGui::Button("save scene (TOML)")) {
+          try {
+            const std::vector<std::string> written = save_scene(session, view.camera, view.display, view.keys, scene_path, true);
+            message = "wrote";
+            for (const std::string& f : written) message += " " + f;
+            message += " (nebula render reproduces the view)";
+          } catch (const std::exception& e) {
+            message = e.what();
+          }
+        }
+      }
+      ImGui::End();
+      if (scene.axial) {
+        // The paint panel: a window of its own at the right, the map at its full width.
+        ImGui::SetNextWindowPos(ImVec2(float(fb_w) - 430, 10), ImGuiCond_FirstUseEver);
+        ImGui::SetNextWindowSize(ImVec2(420, 0), ImGuiCond_FirstUseEver);
+        ImGui::Begin("Axial map");
         // The map M(x, r) as an image (the axis at the bottom), painted with the mouse.
         std::shared_ptr<const AxialMap> map;
         try {
@@ -648,7 +676,7 @@ int run(const Args& args) {
         map_plane = std::min(map_plane, int(planes.size()) - 1);
         std::vector<const char*> plane_names;
         for (const std::string& p : planes) plane_names.push_back(p.c_str());
-        ImGui::Combo("plane (shown and painted)", &map_plane, plane_names.data(), int(plane_names.size()));
+        ImGui::Combo("plane", &map_plane, plane_names.data(), int(plane_names.size()));
         BrushPlane plane;
         plane.band = map_plane - 1;
         if (map && (map != map_shown || map_plane != map_plane_shown)) {
@@ -728,31 +756,8 @@ int run(const Args& args) {
         }
         ImGui::SameLine();
         if (ImGui::Button("revert to the scene's")) session.revert_map();
+        ImGui::End();
       }
-      if (ImGui::CollapsingHeader("Files", ImGuiTreeNodeFlags_DefaultOpen)) {
-        ImGui::InputText("image", screenshot_path, sizeof screenshot_path);
-        if (ImGui::Button("screenshot (.png .exr .fits .h5)")) {
-          try {
-            if (!full) throw Error("no full-size frame yet: let the camera rest");
-            write_screenshot(*full, view, screenshot_path, true);
-            message = std::string("wrote ") + screenshot_path;
-          } catch (const std::exception& e) {
-            message = e.what();
-          }
-        }
-        ImGui::InputText("scene", scene_path, sizeof scene_path);
-        if (ImGui::Button("save scene (TOML)")) {
-          try {
-            const std::vector<std::string> written = save_scene(session, view.camera, view.display, view.keys, scene_path, true);
-            message = "wrote";
-            for (const std::string& f : written) message += " " + f;
-            message += " (nebula render reproduces the view)";
-          } catch (const std::exception& e) {
-            message = e.what();
-          }
-        }
-      }
-      ImGui::End();
     }
     if (last_frame_with_panels) last_frame_with_panels_drawn = true;
     ImGui::Render();
