@@ -732,8 +732,9 @@ int run(const Args& args) {
         ImGui::Combo("mode", &brush_mode, brush_modes, 3);
         ImGui::SliderFloat("radius (texels)", &brush_radius, 0.5f, 128, "%.1f", ImGuiSliderFlags_Logarithmic);
         if (brush_mode != 2) {
-          ImGui::SliderFloat("value", &brush_value, brush_mode == 1 ? -10.0f : 0.0f, 10, "%.4g");
-          if (brush_mode == 0) brush_value = std::max(brush_value, 0.0f);
+          // Typed: emission values are small (0.02 per texel in the bipolar scene), tau_v ones near 1.
+          ImGui::InputFloat(brush_mode == 1 ? "value to add (< 0 removes)" : "value", &brush_value, 0, 0, "%.4g");
+          if (!std::isfinite(brush_value) || (brush_mode == 0 && brush_value < 0)) brush_value = 0;
         }
         ImGui::TextDisabled(map_plane == 0 ? "tau_v: V-band optical depth across one texel" : "emission: radiance gained across one texel");
         ImGui::InputText("map file", map_path, sizeof map_path);
