@@ -48,6 +48,7 @@ struct Args {
   std::vector<std::string> sets;
   std::vector<std::string> paints;  // "x,r,radius,value[,plane]"
   std::string brush_shape = "round", brush_mode = "set", load_map, save_map;
+  std::string paint_drag;  // "x0,r0,x1,r1,radius,value": a mouse drag on the paint panel (automation)
   bool brush_soft = false;
   int frames = 0;  // 0: interactive
   int window_width = 1280, window_height = 800;
@@ -260,6 +261,14 @@ int run(const Args& args) {
   for (const auto& [key, value] : view_sets) set_view(view, key, value);
   if (auto issue = camera_issue(view.camera)) throw Error("--set: camera." + issue->field + ": " + issue->reason);
   const int preview_scale = args.preview_scale > 0 ? args.preview_scale : (backend == Backend::Cpu ? 2 : 1);
+  {
+    BrushShape shape;
+    BrushMode mode;
+    if (!parse_brush_shape(args.brush_shape, shape))
+      throw Error("--brush-shape: expected round or square, got '" + args.brush_shape + "'");
+    if (!parse_brush_mode(args.brush_mode, mode))
+      throw Error("--brush-mode: expected set, add or erase, got '" + args.brush_mode + "'");
+  }
   // The map: loaded, then the scripted strokes, all checked before the first is painted.
   if (!args.load_map.empty()) session.load_map(args.load_map);
   std::vector<Stroke> strokes;
@@ -272,6 +281,23 @@ int run(const Args& args) {
     }
   }
   if (!args.save_map.empty() && !session.scene().axial) throw Error("--save-map: the scene has no [axial] map");
+  // A scripted mouse drag over the paint panel's map image (the interface's own painting path).
+  std::vector<double> drag;
+  if (!args.paint_drag.empty()) {
+    const std::string option = "--paint-drag '" + args.paint_drag + "'";
+    for (size_t begin = 0;;) {
+      const size_t comma = args.paint_drag.find(',', begin);
+      double v = 0;
+      if (!parse_number(args.paint_drag.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin), v))
+        throw Error(option + ": expected x0,r0,x1,r1,radius,value (numbers)");
+      drag.push_back(v);
+      if (comma == std::string::npos) break;
+      begin = comma + 1;
+    }
+    if (drag.size() != 6) throw Error(option + ": expected x0,r0,x1,r1,radius,value, got " + std::to_string(drag.size()) + " field(s)");
+    if (!session.scene().axial) throw Error(option + ": the scene has no [axial] map to paint");
+    if (!automation || !args.show_panels) throw Error(option + ": needs --frames and --show-panels (it drags on the panel)");
+  }
 
   if (!glfwInit()) throw Error("nebula-view: cannot start GLFW (no display? under CI run it with xvfb-run)");
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
@@ -331,9 +357,17 @@ int run(const Args& args) {
   int map_plane = 0, brush_shape = 0, brush_mode = 0;  // plane 0: tau_v, b + 1: band b's emission
   int map_plane_shown = -1;
   float map_max = 0, brush_radius = 6, brush_value = 1;
-  bool brush_soft = false;
+  bool brush_soft = args.brush_soft;
+  brush_shape = args.brush_shape == "square" ? 1 : 0;
+  brush_mode = args.brush_mode == "add" ? 1 : args.brush_mode == "erase" ? 2 : 0;
+  if (!drag.empty()) brush_radius = float(drag[4]), brush_value = float(drag[5]);
   BrushPoint last_dab;
   char map_path[512] = "painted.map.h5";
+  // The map image's place on screen, for --paint-drag: press at the start, kDragSteps moves, release.
+  constexpr int kDragSteps = 8;
+  ImVec2 map_at{0, 0}, map_size{0, 0};
+  int drag_step = drag.empty() ? -1 : 0, map_frames = 0;
+  int total_frames = args.frames;
   auto edit = [&](const std::string& key, const std::string& value) { session.edit(key, value); };
 
   while (!glfwWindowShouldClose(window)) {
@@ -474,6 +508,19 @@ int run(const Args& args) {
     }
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
+    if (drag_step >= 0 && map_frames >= 3 && map_shown) {
+      // After the backend's mouse state: the scripted drag replaces it for this frame. The panel
+      // has been shown for frames (a new window is hidden in its first, and a press where no
+      // window was hovered belongs to the application); the mouse hovers the start one frame
+      // before it presses.
+      const int k = std::max(0, drag_step - 1);
+      const float t = std::min(1.0f, float(k) / kDragSteps);
+      const float x = float(drag[0] + t * (drag[2] - drag[0])), r = float(drag[1] + t * (drag[3] - drag[1]));
+      io.MousePos = ImVec2(map_at.x + x / float(map_shown->nx) * map_size.x, map_at.y + (1 - r / float(map_shown->nr)) * map_size.y);
+      io.MouseDown[0] = drag_step >= 1 && k <= kDragSteps && drag_step <= kDragSteps + 1;
+      drag_step = drag_step <= kDragSteps + 1 ? drag_step + 1 : -1;
+    }
+    if (drag_step >= 0) total_frames = std::max(total_frames, frames + 3);  // the drag finishes first
     ImGui::NewFrame();
     int fb_w = 0, fb_h = 0;
     glfwGetFramebufferSize(window, &fb_w, &fb_h);
@@ -690,6 +737,9 @@ int run(const Args& args) {
           const float w = ImGui::GetContentRegionAvail().x;
           const float h = w * float(map->nr) / float(map->nx);
           const ImVec2 at = ImGui::GetCursorScreenPos();
+          map_at = at;
+          map_size = ImVec2(w, h);
+          ++map_frames;
           ImGui::Image((ImTextureID)(intptr_t)map_texture.id, ImVec2(w, h));
           // A button over the image takes the mouse (a plain image would let a drag move the window).
           ImGui::SetCursorScreenPos(at);
@@ -767,7 +817,7 @@ int run(const Args& args) {
     glClear(GL_COLOR_BUFFER_BIT);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
-    if (automation && frames + 1 >= args.frames && (hide_panels || last_frame_with_panels_drawn)) {
+    if (automation && frames + 1 >= total_frames && (hide_panels || last_frame_with_panels_drawn)) {
       // The last automated frame: the full-size image alone, 1:1 in the window.
       if (!args.window_shot.empty() && !window_shot(window, args.window_shot))
         throw Error(args.window_shot + ": cannot write the window's pixels");
@@ -776,7 +826,7 @@ int run(const Args& args) {
     }
     glfwSwapBuffers(window);
     ++frames;
-    if (automation && frames + 1 >= args.frames) {
+    if (automation && frames + 1 >= total_frames) {
       // Before the last frame: the full-size view, finished, with the panels hidden.
       session.request(requested);
       session.wait_idle();
@@ -851,6 +901,9 @@ int main(int argc, char** argv) {
                  "in order): texel coordinates along the axis and from it, radius in texels, the value, tau_v (the "
                  "default) or a band's emission")
       ->allow_extra_args(false);
+  app.add_option("--paint-drag", a.paint_drag,
+                 "automation with --show-panels: x0,r0,x1,r1,radius,value: a mouse drag on the Axial map panel's "
+                 "image (texels), painted as the mouse paints, with the --brush-* options");
   app.add_option("--brush-shape", a.brush_shape, "--paint's brush: round or square")->capture_default_str();
   app.add_option("--brush-mode", a.brush_mode, "--paint's mode: set, add or erase (empties the texels)")->capture_default_str();
   app.add_flag("--brush-soft", a.brush_soft, "--paint's brush falls off as 1 - d / radius");

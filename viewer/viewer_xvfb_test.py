@@ -8,7 +8,8 @@ the same image; the fisheye shows its dome circle; a bad --set is one line.
 On an axial scene: a scripted --paint of dust brightens the nebula where the
 dust went, the saved scene (with its painted map) re-renders to the same
 image, the map file loads back, erasing everything leaves a black frame, and
-a bad --paint or --load-map is one line naming the option or file.
+a bad --paint or --load-map is one line naming the option or file; a mouse
+drag on the Axial map panel (--paint-drag) paints the texels along it.
 Usage: viewer_xvfb_test.py XVFB_RUN NEBULA_VIEW NEBULA WORK
 """
 import json
@@ -20,8 +21,9 @@ import sys
 try:
     import numpy as np
     import matplotlib.image as mpimg
+    import h5py
 except ImportError as e:  # pragma: no cover
-    print(f"SKIP: {e} (scripts/install-deps.sh installs python3-numpy and python3-matplotlib)")
+    print(f"SKIP: {e} (scripts/install-deps.sh installs python3-numpy, python3-matplotlib and python3-h5py)")
     sys.exit(77)
 
 xvfb, view, nebula, work = sys.argv[1:5]
@@ -178,6 +180,24 @@ check(np.array_equal(png("ax2.png"), ax1), "the saved map loads back to the pain
 run_ax("--paint", ring, "--brush-mode", "erase", "--brush-shape", "square", "--paint", "64,32,200,0",
        "--screenshot", "ax3.png")
 check(ax0.max() > 0.1 and png("ax3.png").max() == 0, "erasing the whole map leaves a black frame")
+
+# The interface's own painting: a mouse drag across the Axial map panel's image from
+# (x, r) = (20, 40) to (100, 40) texels, radius 3, tau_v 0.4. Texels within 2 of the
+# segment are painted; none beyond 3.5 (the mouse moves by whole pixels, 1/3 texel here).
+run_view("--frames", "2", "--show-panels", "--window-width", "1000", "--window-height", "700",
+         "--paint-drag", "20,40,100,40,3,0.4", "--save-map", "drag.h5", scene="ax.toml")
+run_ax("--save-map", "nodrag.h5")
+with h5py.File(os.path.join(work, "drag.h5"), "r") as f:
+    dragged = f["tau_v"][:]
+with h5py.File(os.path.join(work, "nodrag.h5"), "r") as f:
+    plain = f["tau_v"][:]
+x, r = np.meshgrid(np.arange(128) + 0.5, np.arange(64) + 0.5)  # texel centres, [nr][nx]
+dist = np.hypot(x - np.clip(x, 20, 100), r - 40)
+changed = dragged != plain
+check(changed.any() and np.all(dragged[changed] == np.float32(0.4)) and dist[changed].max() <= 3.5 and
+      np.all(dragged[dist <= 2] == np.float32(0.4)),
+      f"a mouse drag on the panel paints along it: {changed.sum()} texels, the farthest "
+      f"{dist[changed].max() if changed.any() else 0:.2f} from the segment")
 
 # Bad paint and map input: one line naming the option or file, non-zero exit, nothing written.
 with open(os.path.join(work, "junk.h5"), "w") as f:
