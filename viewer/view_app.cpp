@@ -119,19 +119,23 @@ bool set_view(View& v, const std::string& key, const std::string& value) {
   return true;
 }
 
-// One --paint: "x,r,radius,value[,plane]" (texels, texels, texels, the
-// value, tau_v or a band name; tau_v when left out) with the --brush-* options.
-// Error naming the option for a wrong number of fields, a field that is not a
-// number, or a plane the scene does not have.
-Stroke parse_paint(const std::string& text, const Scene& scene, const Args& args) {
-  const std::string option = "--paint '" + text + "'";
+std::vector<std::string> split_commas(const std::string& text) {
   std::vector<std::string> fields;
   for (size_t begin = 0;;) {
     const size_t comma = text.find(',', begin);
     fields.push_back(text.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin));
-    if (comma == std::string::npos) break;
+    if (comma == std::string::npos) return fields;
     begin = comma + 1;
   }
+}
+
+// One --paint: "x,r,radius,value[,plane]" (texels, texels, texels, the
+// value, tau_v or a band name; tau_v when left out) with the --brush-* options
+// (checked before). Error naming the option for a wrong number of fields, a
+// field that is not a number, or a plane the scene does not have.
+Stroke parse_paint(const std::string& text, const Scene& scene, const Args& args) {
+  const std::string option = "--paint '" + text + "'";
+  const std::vector<std::string> fields = split_commas(text);
   if (fields.size() != 4 && fields.size() != 5)
     throw Error(option + ": expected x,r,radius,value[,plane] (texels, texels, texels, value, tau_v or a band), got " +
                 std::to_string(fields.size()) + " field(s)");
@@ -141,10 +145,8 @@ Stroke parse_paint(const std::string& text, const Scene& scene, const Args& args
     if (!parse_number(fields[size_t(i)], v[i])) throw Error(option + ": " + names[i] + " '" + fields[size_t(i)] + "' is not a number");
   if (!scene.axial) throw Error(option + ": the scene has no [axial] map to paint");
   Stroke stroke;
-  if (!parse_brush_shape(args.brush_shape, stroke.brush.shape))
-    throw Error("--brush-shape: expected round or square, got '" + args.brush_shape + "'");
-  if (!parse_brush_mode(args.brush_mode, stroke.brush.mode))
-    throw Error("--brush-mode: expected set, add or erase, got '" + args.brush_mode + "'");
+  parse_brush_shape(args.brush_shape, stroke.brush.shape);
+  parse_brush_mode(args.brush_mode, stroke.brush.mode);
   stroke.brush.soft = args.brush_soft;
   stroke.brush.radius = float(v[2]);
   stroke.brush.value = float(v[3]);
@@ -285,14 +287,10 @@ int run(const Args& args) {
   std::vector<double> drag;
   if (!args.paint_drag.empty()) {
     const std::string option = "--paint-drag '" + args.paint_drag + "'";
-    for (size_t begin = 0;;) {
-      const size_t comma = args.paint_drag.find(',', begin);
+    for (const std::string& field : split_commas(args.paint_drag)) {
       double v = 0;
-      if (!parse_number(args.paint_drag.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin), v))
-        throw Error(option + ": expected x0,r0,x1,r1,radius,value (numbers)");
+      if (!parse_number(field, v)) throw Error(option + ": '" + field + "' is not a number (x0,r0,x1,r1,radius,value)");
       drag.push_back(v);
-      if (comma == std::string::npos) break;
-      begin = comma + 1;
     }
     if (drag.size() != 6) throw Error(option + ": expected x0,r0,x1,r1,radius,value, got " + std::to_string(drag.size()) + " field(s)");
     if (!session.scene().axial) throw Error(option + ": the scene has no [axial] map to paint");
