@@ -52,7 +52,31 @@ void read_image_map(const Scene& scene, AxialMap& m) {
   }
 }
 
+// The scene's step check and the map's placement: texel, origin, axis.
+void place(const Scene& scene, AxialMap& m) {
+  const AxialSpec& a = *scene.axial;
+  // A step longer than the map crosses it in one sample: the march would see
+  // (almost) nothing of it, a wrong image rather than a coarse one.
+  const int map_texels = std::max(m.nx, m.nr);
+  if (!(a.step_texels <= map_texels))
+    throw ParameterError("axial.step_texels", "is " + to_text(a.step_texels) + "; must be at most " +
+                                                  std::to_string(map_texels) + ", the map's larger size in texels");
+  m.texel = static_cast<float>(a.length_pc / m.nx);
+  m.origin = a.origin;
+  m.axis = a.axis;
+}
+
 }  // namespace
+
+AxialMap place_axial_map(const Scene& scene, AxialMap m) {
+  if (!m.emission.empty() && m.emission.size() != scene.bands.size())
+    throw Error(scene.path + ": axial: the map in memory has " + std::to_string(m.emission.size()) +
+                " emission planes for the scene's " + std::to_string(scene.bands.size()) + " bands");
+  place(scene, m);
+  check_axial_map(m, scene.path + ": axial");
+  m.update_skip_structures();
+  return m;
+}
 
 AxialMap build_axial_map(const Scene& scene) {
   const AxialSpec& a = *scene.axial;
@@ -84,15 +108,7 @@ AxialMap build_axial_map(const Scene& scene) {
   } else {
     read_image_map(scene, m);
   }
-  // A step longer than the map crosses it in one sample: the march would see
-  // (almost) nothing of it, a wrong image rather than a coarse one.
-  const int map_texels = std::max(m.nx, m.nr);
-  if (!(a.step_texels <= map_texels))
-    throw ParameterError("axial.step_texels", "is " + to_text(a.step_texels) + "; must be at most " +
-                                                  std::to_string(map_texels) + ", the map's larger size in texels");
-  m.texel = static_cast<float>(a.length_pc / m.nx);
-  m.origin = a.origin;
-  m.axis = a.axis;
+  place(scene, m);
   for (float& v : m.tau_v) v = static_cast<float>(v * a.tau_scale);
   if (a.emission_scale == 0) m.emission.clear();
   for (auto& plane : m.emission)

@@ -3,6 +3,10 @@
 #include <gtest/gtest.h>
 
 #include "pipeline/axial_map_source.h"
+
+#include <memory>
+
+#include "pipeline/render_scene.h"
 #include "core/error.h"
 #include "imageio/image_output.h"
 #include "scene/scene_file.h"
@@ -28,6 +32,43 @@ TEST_F(AxialMapSource, Synthetic) {
   ASSERT_EQ(m.emission.size(), 2u);
   for (size_t i = 0; i < m.count(); ++i) ASSERT_FLOAT_EQ(m.tau_v[i], 2.0f * ref.tau_v[i]);
   EXPECT_EQ(m.global_max, ref.global_max);
+}
+
+// A map given in memory (the viewer's painted one) renders in the scene's
+// place of its own: the scene's map given so renders the same image bit for
+// bit; emptied, nothing shines (no stars: emission is the only light).
+TEST_F(AxialMapSource, MapInMemoryReplacesTheScenes) {
+  Scene s = scene("synthetic = \"shells\"\nnx = 40\nnr = 20\ntau_scale = 2.0\norigin = [0.0, 0.0, 0.5]");
+  s.camera.width = 24;
+  s.camera.height = 24;
+  const AxialMap built = build_axial_map(s);
+  AxialMap unplaced = built;
+  unplaced.texel = 7;
+  unplaced.origin = {9, 9, 9};
+  const AxialMap placed = place_axial_map(s, unplaced);
+  EXPECT_FLOAT_EQ(placed.texel, 0.05f);
+  EXPECT_FLOAT_EQ(placed.origin.z, 0.5f);
+  EXPECT_EQ(placed.tau_v, built.tau_v);  // no tau_scale applied a second time
+
+  RenderOptions o;
+  const RenderOutput plain = render_scene(s, o);
+  o.axial_map = std::make_shared<const AxialMap>(built);
+  const RenderOutput given = render_scene(s, o);
+  double total = 0;
+  for (float v : plain.image.pixels) total += v;
+  ASSERT_GT(total, 0);
+  EXPECT_EQ(given.image.pixels, plain.image.pixels);
+  EXPECT_EQ(given.report.axial->source, "in memory (painted)");
+
+  AxialMap dark = built;
+  for (auto& plane : dark.emission) std::fill(plane.begin(), plane.end(), 0.0f);
+  o.axial_map = std::make_shared<const AxialMap>(dark);
+  for (float v : render_scene(s, o).image.pixels) ASSERT_EQ(v, 0.0f);
+
+  AxialMap three = built;
+  three.emission.push_back(three.emission[0]);
+  o.axial_map = std::make_shared<const AxialMap>(three);
+  testing::expect_error([&] { render_scene(s, o); }, {"axial", "3 emission planes", "2 bands"});
 }
 
 TEST_F(AxialMapSource, Hdf5DatasetsWithEmission) {

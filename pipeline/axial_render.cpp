@@ -45,9 +45,10 @@ RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
   const size_t n_bands = scene.bands.size();
 
   const auto t_map = std::chrono::steady_clock::now();
-  const AxialMap map = build_axial_map(scene);
+  const AxialMap map = o.axial_map ? place_axial_map(scene, *o.axial_map) : build_axial_map(scene);
   AxialMapReport map_report;
-  map_report.source = spec.source + " " + (spec.source == "synthetic" ? spec.synthetic : spec.path);
+  map_report.source = o.axial_map ? std::string("in memory (painted)")
+                                  : spec.source + " " + (spec.source == "synthetic" ? spec.synthetic : spec.path);
   map_report.nx = map.nx;
   map_report.nr = map.nr;
   map_report.texel_pc = map.texel;

@@ -7,10 +7,12 @@
 // bars aside) and names scene keys or option fields in its errors
 // (ParameterError), never command-line options.
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "axial/axial_map.h"
 #include "core/backend.h"
 #include "core/image.h"
 #include "diffuse/diffuse_field.h"
@@ -45,6 +47,11 @@ struct RenderOptions {
   uint64_t table_photons = 30000;  // photons per row of tables generated on first use
   float smooth_step = 0;           // "smooth_step": voxels; 0 is the exact traversal (3D grids only)
   bool progress = false;           // progress bars on stderr for CPU work
+  // Set: an [axial] scene renders this map instead of building the one its
+  // table names (the viewer's painted map, its values as the renderer takes
+  // them: after axial.tau_scale and emission_scale); placed by the scene's
+  // axial.length_pc, origin and axis (place_axial_map).
+  std::shared_ptr<const AxialMap> axial_map;
 };
 
 struct RenderOutput {
@@ -116,6 +123,7 @@ struct TruthOptions {
   bool exact_transmittance = false;  // next-event transmittance by the exact voxel sum
   bool equiangular = false;          // equiangular next-event samples too (MIS)
   int axial_voxels = 256;            // "axial_voxels": an axial map is traced voxelized, this many along its longer side
+  std::shared_ptr<const AxialMap> axial_map;  // set: traced instead of the scene's (RenderOptions::axial_map)
   bool progress = false;
 };
 

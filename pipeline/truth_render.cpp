@@ -29,9 +29,9 @@ struct AxialFrame {
   Vec3 vector(Vec3 v) const { return {dot(rows[0], v), dot(rows[1], v), dot(rows[2], v)}; }
 };
 
-AxialFrame axial_frame(const Scene& scene, int voxels) {
+AxialFrame axial_frame(const Scene& scene, int voxels, const std::shared_ptr<const AxialMap>& given) {
   if (voxels < 8 || voxels > 2048) throw ParameterError("axial_voxels", "must be 8 to 2048, got " + std::to_string(voxels));
-  const AxialMap map = build_axial_map(scene);
+  const AxialMap map = given ? place_axial_map(scene, *given) : build_axial_map(scene);
   AxialFrame f;
   const float longest = std::max(map.length(), 2.0f * map.radius());
   f.density = voxelize_axial_frame(map, longest / float(voxels), &f.emission);
@@ -67,7 +67,7 @@ TruthRenderOutput truth_scene(const Scene& scene, const TruthOptions& o) {
       throw ParameterError(scene.path + ": axial." +
                                (scene.axial->colour_deform.on ? "colour_deform" : "shape_deform"),
                            "the path tracer traces the undeformed map; deformations are for `nebula render`");
-    frame = axial_frame(scene, o.axial_voxels);
+    frame = axial_frame(scene, o.axial_voxels, o.axial_map);
     in.density = &frame.density;
     for (size_t b = 0; b < sb.bands.size(); ++b)
       in.bands[b].emission = frame.emission.empty() ? nullptr : &frame.emission[b];

@@ -1052,4 +1052,27 @@ Scene demo_scene() {
   return scene;
 }
 
+std::string scene_text_with_axial_file(const std::string& text, const std::string& file,
+                                       const std::string& emission_prefix) {
+  toml::table root;
+  try {
+    root = toml::parse(std::string_view(text), std::string_view("scene"));
+  } catch (const toml::parse_error& e) {
+    throw Error(one_line(std::string("scene text: TOML syntax: ") + std::string(e.description())));
+  }
+  toml::table* axial = root["axial"].as_table();
+  if (axial == nullptr) throw Error("scene text: no [axial] table to point at " + file);
+  for (const char* key : {"synthetic", "nx", "nr", "file", "image", "dataset", "emission_prefix", "tau_channel",
+                          "emission_channels"})
+    axial->erase(key);
+  axial->insert_or_assign("file", file);
+  axial->insert_or_assign("dataset", "tau_v");
+  if (!emission_prefix.empty()) axial->insert_or_assign("emission_prefix", emission_prefix);
+  axial->insert_or_assign("tau_scale", 1.0);
+  axial->insert_or_assign("emission_scale", 1.0);
+  std::ostringstream out;
+  out << toml::toml_formatter(root);
+  return out.str();
+}
+
 }  // namespace nebula

@@ -30,6 +30,16 @@ Scene load_scene_text(const std::string& text, const std::string& name,
                       const std::string& base_dir, const std::vector<std::string>& overrides = {},
                       const Scene* reuse_grids = nullptr);
 
+// A scene's TOML text (such as Scene::resolved_toml) with its [axial] map
+// read from an HDF5 file instead (the viewer's painted map, saved): the keys
+// naming the map (synthetic, nx, nr, file, image, dataset, emission_prefix,
+// tau_channel, emission_channels) give way to file = `file`, dataset =
+// "tau_v", emission_prefix = `emission_prefix` (when not empty), and
+// tau_scale = emission_scale = 1 (the file holds the values as rendered);
+// every other key stays as written. Error when the text has no [axial] table.
+std::string scene_text_with_axial_file(const std::string& text, const std::string& file,
+                                       const std::string& emission_prefix);
+
 // The built-in demo (`nebula render --demo`), equal to scenes/demo.toml: a
 // procedural nebula tuned to show structure (128^3 voxels, 2 pc; the star
 // off-centre, filaments, docs/scene.md), one O5V star of 2e5 L_sun at the

@@ -305,6 +305,44 @@ TEST_F(SceneFile, RefusesBadDensityFiles) {
   refused("table_missing", edited("R_V = 5.0", "R_V = 5.0\ntables = { V = \"tV.h5\" }"), {"dust.tables.V", "tV.h5"});
 }
 
+// The viewer's painted map saved: the [axial] table reads the file instead of
+// building its map, with the scales of 1 (the file holds the values as
+// rendered); everything else, deformations included, as written.
+TEST_F(SceneFile, AxialMapFileReplacesTheKeysNamingTheMap) {
+  const std::string text = R"(bands = ["B", "V"]
+[axial]
+synthetic = "bipolar"
+nx = 64
+nr = 32
+tau_scale = 3.0
+emission_scale = 0.5
+length_pc = 4.0
+step_texels = 0.25
+[axial.colour_deform]
+kind = "simplex"
+[camera]
+position = [4.0, 0.0, 1.0]
+look_at = [0.0, 0.0, 1.0]
+)";
+  write_text("painted.map.h5", "only its existence is checked here");
+  const std::string out = scene_text_with_axial_file(text, "painted.map.h5", "emission_");
+  const Scene s = load_scene(write_text("painted.toml", out));
+  ASSERT_TRUE(s.axial.has_value());
+  EXPECT_EQ(s.axial->source, "file");
+  EXPECT_EQ(s.axial->path, path("painted.map.h5"));
+  EXPECT_EQ(s.axial->dataset, "tau_v");
+  EXPECT_EQ(s.axial->emission_prefix, "emission_");
+  EXPECT_EQ(s.axial->tau_scale, 1.0);
+  EXPECT_EQ(s.axial->emission_scale, 1.0);
+  EXPECT_EQ(s.axial->length_pc, 4.0);
+  EXPECT_EQ(s.axial->step_texels, 0.25);
+  EXPECT_TRUE(s.axial->colour_deform.on);
+  EXPECT_EQ(s.axial->colour_deform.kind, "simplex");
+  EXPECT_EQ(scene_text_with_axial_file(text, "m.h5", "").find("emission_prefix"), std::string::npos);
+  testing::expect_error([&] { scene_text_with_axial_file("[camera]\nfov_deg = 30\n", "m.h5", ""); },
+                        {"no [axial] table", "m.h5"});
+}
+
 TEST_F(SceneFile, RefusesAMissingSceneFile) {
   expect_error([&] { load_scene(path("nothing.toml")); }, {"nothing.toml", "cannot read", "No such file"});
   expect_error([&] { load_scene(dir_.string()); }, {"directory"});

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "axial/axial_brush.h"
 #include "core/display.h"
 #include "core/image.h"
 #include "imageio/image_output.h"
@@ -20,5 +21,12 @@ struct Rgba8 {
 
 // `metadata` names the bands' pivot wavelengths for bands other than B, V, R (rendered frames carry them).
 Rgba8 display_image(const Image& image, double exposure, const DisplaySettings& display, const ImageMetadata& metadata);
+
+// One plane of an axial map as the paint panel shows it: x to the right, the
+// axis (r = 0) at the bottom row; grey levels sqrt(v / max) of the plane's
+// largest value (returned in *max_value; all black for an empty plane, or an
+// emission plane the map lacks). Painted texels with no dust but emission
+// are tinted blue on the tau_v plane so that emission alone stays visible.
+Rgba8 map_plane_image(const AxialMap& map, BrushPlane plane, float* max_value = nullptr);
 
 }  // namespace nebula::viewer

@@ -3,9 +3,11 @@
 // kinds; live edits of the dust, the stars, the multiple-scattering mode and
 // the display, re-baked in the background (viewer/viewer_session.h) while the
 // previous frame stays on screen; a reduced resolution while the camera moves,
-// the full one when it rests; screenshots, "save scene" and keyframes. An
-// automation mode (--frames N --set KEY=VALUE --screenshot F) runs the real
-// window and interface for tests and scripted pictures.
+// the full one when it rests; screenshots, "save scene" and keyframes; for an
+// axial scene, the 2D map painted with a brush (Khalass 2021 section 4.1),
+// loaded and saved. An automation mode (--frames N --set KEY=VALUE --paint
+// x,r,radius,value --screenshot F) runs the real window and interface for
+// tests and scripted pictures.
 #define GL_GLEXT_PROTOTYPES  // buffer objects (OpenGL 1.5+) from Mesa's or NVIDIA's libGL
 #define GLFW_INCLUDE_GLEXT
 #include <GLFW/glfw3.h>
@@ -44,6 +46,10 @@ using Clock = std::chrono::steady_clock;
 struct Args {
   std::string scene, backend = "auto", screenshot, window_shot, save_scene;
   std::vector<std::string> sets;
+  std::vector<std::string> paints;  // "x,r,radius,value[,plane]"
+  std::string brush_shape = "round", brush_mode = "set", load_map, save_map;
+  std::string paint_drag;  // "x0,r0,x1,r1,radius,value": a mouse drag on the paint panel (automation)
+  bool brush_soft = false;
   int frames = 0;  // 0: interactive
   int window_width = 1280, window_height = 800;
   int preview_scale = 0;       // 0: 2 on the CPU, 1 on the GPU
@@ -115,27 +121,40 @@ bool set_view(View& v, const std::string& key, const std::string& value) {
   return true;
 }
 
-// Writes the scene the viewer shows as TOML (written aside and renamed).
-void save_scene(const Session& session, const View& view, const std::string& path, bool force) {
-  check_output_target(path, force, "folder", true);
-  SceneSource source = session.source();
-  set_view_overrides(source, view.camera, view.display, view.keys);
-  const Scene scene = source.load_reusing(session.scene());
-  // Data files named relative to the scene's folder must stay findable.
-  namespace fs = std::filesystem;
-  const fs::path there = fs::absolute(fs::path(path)).parent_path().lexically_normal();
-  const fs::path here = fs::absolute(fs::path(source.base_dir())).lexically_normal();
-  for (const SceneInput& input : scene.inputs)
-    if (input.key != "scene" && there != here)
-      throw Error(path + ": save the scene in " + here.string() + ", the folder of " + source.name() + ": its " +
-                  input.key + " is named relative to it");
-  TemporaryFile temporary(path);
-  {
-    std::ofstream out(temporary.path(), std::ios::binary | std::ios::trunc);
-    out << session.saved_scene_text(view.camera, view.display, view.keys);
-    if (!out.flush()) throw Error("cannot write " + path);
+std::vector<std::string> split_commas(const std::string& text) {
+  std::vector<std::string> fields;
+  for (size_t begin = 0;;) {
+    const size_t comma = text.find(',', begin);
+    fields.push_back(text.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin));
+    if (comma == std::string::npos) return fields;
+    begin = comma + 1;
   }
-  temporary.publish();
+}
+
+// One --paint: "x,r,radius,value[,plane]" (texels, texels, texels, the
+// value, tau_v or a band name; tau_v when left out) with the --brush-* options
+// (checked before). Error naming the option for a wrong number of fields, a
+// field that is not a number, or a plane the scene does not have.
+Stroke parse_paint(const std::string& text, const Scene& scene, const Args& args) {
+  const std::string option = "--paint '" + text + "'";
+  const std::vector<std::string> fields = split_commas(text);
+  if (fields.size() != 4 && fields.size() != 5)
+    throw Error(option + ": expected x,r,radius,value[,plane] (texels, texels, texels, value, tau_v or a band), got " +
+                std::to_string(fields.size()) + " field(s)");
+  double v[4];
+  const char* names[] = {"x", "r", "radius", "value"};
+  for (int i = 0; i < 4; ++i)
+    if (!parse_number(fields[size_t(i)], v[i])) throw Error(option + ": " + names[i] + " '" + fields[size_t(i)] + "' is not a number");
+  if (!scene.axial) throw Error(option + ": the scene has no [axial] map to paint");
+  Stroke stroke;
+  parse_brush_shape(args.brush_shape, stroke.brush.shape);
+  parse_brush_mode(args.brush_mode, stroke.brush.mode);
+  stroke.brush.soft = args.brush_soft;
+  stroke.brush.radius = float(v[2]);
+  stroke.brush.value = float(v[3]);
+  stroke.brush.plane = brush_plane(scene, fields.size() == 5 ? fields[4] : "tau_v", option);
+  stroke.dabs.push_back({float(v[0]), float(v[1])});
+  return stroke;
 }
 
 void write_screenshot(const Frame& frame, const View& view, const std::string& path, bool force) {
@@ -207,7 +226,7 @@ int run(const Args& args) {
     throw Error("--backend: expected cpu, cuda or auto, got '" + args.backend + "'");
   }
   if (args.frames < 0) throw Error("--frames: must be >= 0");
-  for (const std::string& out : {args.screenshot, args.save_scene, args.window_shot})
+  for (const std::string& out : {args.screenshot, args.save_scene, args.window_shot, args.save_map})
     if (!out.empty()) check_output_target(out, args.force, "folder", true);
   if (!args.screenshot.empty()) check_image_format(args.screenshot);
   const bool automation = args.frames > 0;
@@ -248,6 +267,39 @@ int run(const Args& args) {
   for (const auto& [key, value] : view_sets) set_view(view, key, value);
   if (auto issue = camera_issue(view.camera)) throw Error("--set: camera." + issue->field + ": " + issue->reason);
   const int preview_scale = args.preview_scale > 0 ? args.preview_scale : (backend == Backend::Cpu ? 2 : 1);
+  {
+    BrushShape shape;
+    BrushMode mode;
+    if (!parse_brush_shape(args.brush_shape, shape))
+      throw Error("--brush-shape: expected round or square, got '" + args.brush_shape + "'");
+    if (!parse_brush_mode(args.brush_mode, mode))
+      throw Error("--brush-mode: expected set, add or erase, got '" + args.brush_mode + "'");
+  }
+  // The map: loaded, then the scripted strokes, all checked before the first is painted.
+  if (!args.load_map.empty()) session.load_map(args.load_map);
+  std::vector<Stroke> strokes;
+  for (const std::string& p : args.paints) strokes.push_back(parse_paint(p, session.scene(), args));
+  for (size_t i = 0; i < strokes.size(); ++i) {
+    try {
+      session.paint(strokes[i]);
+    } catch (const Error& e) {
+      throw Error("--paint '" + args.paints[i] + "': " + e.what());
+    }
+  }
+  if (!args.save_map.empty() && !session.scene().axial) throw Error("--save-map: the scene has no [axial] map");
+  // A scripted mouse drag over the paint panel's map image (the interface's own painting path).
+  std::vector<double> drag;
+  if (!args.paint_drag.empty()) {
+    const std::string option = "--paint-drag '" + args.paint_drag + "'";
+    for (const std::string& field : split_commas(args.paint_drag)) {
+      double v = 0;
+      if (!parse_number(field, v)) throw Error(option + ": '" + field + "' is not a number (x0,r0,x1,r1,radius,value)");
+      drag.push_back(v);
+    }
+    if (drag.size() != 6) throw Error(option + ": expected x0,r0,x1,r1,radius,value, got " + std::to_string(drag.size()) + " field(s)");
+    if (!session.scene().axial) throw Error(option + ": the scene has no [axial] map to paint");
+    if (!automation || !args.show_panels) throw Error(option + ": needs --frames and --show-panels (it drags on the panel)");
+  }
 
   if (!glfwInit()) throw Error("nebula-view: cannot start GLFW (no display? under CI run it with xvfb-run)");
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
@@ -301,6 +353,23 @@ int run(const Args& args) {
   const char* kinds[] = {"perspective", "orthographic", "fisheye"};
   const char* stretches[] = {"linear", "asinh", "log"};
   const char* modes[] = {"diffuse", "pyramid", "none"};
+  // The paint panel's state (an axial scene only).
+  Texture map_texture;
+  std::shared_ptr<const AxialMap> map_shown;
+  int map_plane = 0, brush_shape = 0, brush_mode = 0;  // plane 0: tau_v, b + 1: band b's emission
+  int map_plane_shown = -1;
+  float map_max = 0, brush_radius = 6, brush_value = 1;
+  bool brush_soft = args.brush_soft;
+  brush_shape = args.brush_shape == "square" ? 1 : 0;
+  brush_mode = args.brush_mode == "add" ? 1 : args.brush_mode == "erase" ? 2 : 0;
+  if (!drag.empty()) brush_radius = float(drag[4]), brush_value = float(drag[5]);
+  BrushPoint last_dab;
+  char map_path[512] = "painted.map.h5";
+  // The map image's place on screen, for --paint-drag: press at the start, kDragSteps moves, release.
+  constexpr int kDragSteps = 8;
+  ImVec2 map_at{0, 0}, map_size{0, 0};
+  int drag_step = drag.empty() ? -1 : 0, map_frames = 0;
+  int total_frames = args.frames;
   auto edit = [&](const std::string& key, const std::string& value) { session.edit(key, value); };
 
   while (!glfwWindowShouldClose(window)) {
@@ -445,6 +514,19 @@ int run(const Args& args) {
     }
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
+    if (drag_step >= 0 && map_frames >= 3 && map_shown) {
+      // After the backend's mouse state: the scripted drag replaces it for this frame. The panel
+      // has been shown for frames (a new window is hidden in its first, and a press where no
+      // window was hovered belongs to the application); the mouse hovers the start one frame
+      // before it presses.
+      const int k = std::max(0, drag_step - 1);
+      const float t = std::min(1.0f, float(k) / kDragSteps);
+      const float x = float(drag[0] + t * (drag[2] - drag[0])), r = float(drag[1] + t * (drag[3] - drag[1]));
+      io.MousePos = ImVec2(map_at.x + x / float(map_shown->nx) * map_size.x, map_at.y + (1 - r / float(map_shown->nr)) * map_size.y);
+      io.MouseDown[0] = drag_step >= 1 && k <= kDragSteps && drag_step <= kDragSteps + 1;
+      drag_step = drag_step <= kDragSteps + 1 ? drag_step + 1 : -1;
+    }
+    if (drag_step >= 0) total_frames = std::max(total_frames, frames + 3);  // the drag finishes first
     ImGui::NewFrame();
     int fb_w = 0, fb_h = 0;
     glfwGetFramebufferSize(window, &fb_w, &fb_h);
@@ -620,14 +702,119 @@ int run(const Args& args) {
         ImGui::InputText("scene", scene_path, sizeof scene_path);
         if (ImGui::Button("save scene (TOML)")) {
           try {
-            save_scene(session, view, scene_path, true);
-            message = std::string("wrote ") + scene_path + " (nebula render reproduces the view)";
+            const std::vector<std::string> written = save_scene(session, view.camera, view.display, view.keys, scene_path, true);
+            message = "wrote";
+            for (const std::string& f : written) message += " " + f;
+            message += " (nebula render reproduces the view)";
           } catch (const std::exception& e) {
             message = e.what();
           }
         }
       }
       ImGui::End();
+      if (scene.axial) {
+        // The paint panel: a window of its own at the right, the map at its full width.
+        ImGui::SetNextWindowPos(ImVec2(float(fb_w) - 430, 10), ImGuiCond_FirstUseEver);
+        ImGui::SetNextWindowSize(ImVec2(420, 0), ImGuiCond_FirstUseEver);
+        ImGui::Begin("Axial map");
+        // The map M(x, r) as an image (the axis at the bottom), painted with the mouse.
+        std::shared_ptr<const AxialMap> map;
+        try {
+          map = session.axial_map();
+        } catch (const std::exception& e) {
+          ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", e.what());
+        }
+        std::vector<std::string> planes{"tau_v"};
+        for (const std::string& b : scene.bands) planes.push_back("emission " + b);
+        map_plane = std::min(map_plane, int(planes.size()) - 1);
+        std::vector<const char*> plane_names;
+        for (const std::string& p : planes) plane_names.push_back(p.c_str());
+        ImGui::Combo("plane", &map_plane, plane_names.data(), int(plane_names.size()));
+        BrushPlane plane;
+        plane.band = map_plane - 1;
+        if (map && (map != map_shown || map_plane != map_plane_shown)) {
+          map_texture.upload(map_plane_image(*map, plane, &map_max));
+          map_shown = map;
+          map_plane_shown = map_plane;
+        }
+        if (map) {
+          ImGui::Text("%d x %d texels of %.4g pc; largest %s %.4g%s", map->nx, map->nr, double(map->texel),
+                      planes[size_t(map_plane)].c_str(), double(map_max), session.map_edited() ? "; edited" : "");
+          const float w = ImGui::GetContentRegionAvail().x;
+          const float h = w * float(map->nr) / float(map->nx);
+          const ImVec2 at = ImGui::GetCursorScreenPos();
+          map_at = at;
+          map_size = ImVec2(w, h);
+          ++map_frames;
+          ImGui::Image((ImTextureID)(intptr_t)map_texture.id, ImVec2(w, h));
+          // A button over the image takes the mouse (a plain image would let a drag move the window).
+          ImGui::SetCursorScreenPos(at);
+          ImGui::InvisibleButton("##map", ImVec2(w, h));
+          const bool hovered = ImGui::IsItemHovered(), pressed = ImGui::IsItemActivated();
+          const bool painting = ImGui::IsItemActive();
+          const ImVec2 mouse = ImGui::GetMousePos();
+          const BrushPoint here{(mouse.x - at.x) / w * float(map->nx), (1.0f - (mouse.y - at.y) / h) * float(map->nr)};
+          if (hovered) {
+            const float rp = brush_radius * w / float(map->nx);
+            ImDrawList* draw = ImGui::GetWindowDrawList();
+            if (brush_shape == 0)
+              draw->AddCircle(mouse, rp, IM_COL32(255, 200, 0, 255), 32);
+            else
+              draw->AddRect(ImVec2(mouse.x - rp, mouse.y - rp), ImVec2(mouse.x + rp, mouse.y + rp), IM_COL32(255, 200, 0, 255));
+          }
+          const bool moved = painting && (here.x != last_dab.x || here.r != last_dab.r);
+          if (painting && (pressed || moved)) {
+            Stroke stroke;
+            stroke.brush.shape = BrushShape(brush_shape);
+            stroke.brush.mode = BrushMode(brush_mode);
+            stroke.brush.soft = brush_soft;
+            stroke.brush.radius = brush_radius;
+            stroke.brush.value = brush_value;
+            stroke.brush.plane = plane;
+            stroke.dabs = pressed ? std::vector<BrushPoint>{here} : brush_segment(last_dab, here, brush_radius);
+            try {
+              session.paint(stroke);
+            } catch (const std::exception& e) {
+              message = e.what();
+            }
+            last_dab = here;
+          }
+        }
+        const char* shapes[] = {"round", "square"};
+        const char* brush_modes[] = {"set", "add", "erase"};
+        ImGui::Combo("brush", &brush_shape, shapes, 2);
+        ImGui::SameLine();
+        ImGui::Checkbox("soft", &brush_soft);
+        ImGui::Combo("mode", &brush_mode, brush_modes, 3);
+        ImGui::SliderFloat("radius (texels)", &brush_radius, 0.5f, 128, "%.1f", ImGuiSliderFlags_Logarithmic);
+        if (brush_mode != 2) {
+          // Typed: emission values are small (0.02 per texel in the bipolar scene), tau_v ones near 1.
+          ImGui::InputFloat(brush_mode == 1 ? "value to add (< 0 removes)" : "value", &brush_value, 0, 0, "%.4g");
+          if (!std::isfinite(brush_value) || (brush_mode == 0 && brush_value < 0)) brush_value = 0;
+        }
+        ImGui::TextDisabled(map_plane == 0 ? "tau_v: V-band optical depth across one texel" : "emission: radiance gained across one texel");
+        ImGui::InputText("map file", map_path, sizeof map_path);
+        if (ImGui::Button("load map")) {
+          try {
+            session.load_map(map_path);
+            message = std::string("loaded ") + map_path;
+          } catch (const std::exception& e) {
+            message = e.what();
+          }
+        }
+        ImGui::SameLine();
+        if (ImGui::Button("save map (HDF5)")) {
+          try {
+            session.save_map(map_path, true);
+            message = std::string("wrote ") + map_path;
+          } catch (const std::exception& e) {
+            message = e.what();
+          }
+        }
+        ImGui::SameLine();
+        if (ImGui::Button("revert to the scene's")) session.revert_map();
+        ImGui::End();
+      }
     }
     if (last_frame_with_panels) last_frame_with_panels_drawn = true;
     ImGui::Render();
@@ -636,7 +823,7 @@ int run(const Args& args) {
     glClear(GL_COLOR_BUFFER_BIT);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
-    if (automation && frames + 1 >= args.frames && (hide_panels || last_frame_with_panels_drawn)) {
+    if (automation && frames + 1 >= total_frames && (hide_panels || last_frame_with_panels_drawn)) {
       // The last automated frame: the full-size image alone, 1:1 in the window.
       if (!args.window_shot.empty() && !window_shot(window, args.window_shot))
         throw Error(args.window_shot + ": cannot write the window's pixels");
@@ -645,7 +832,7 @@ int run(const Args& args) {
     }
     glfwSwapBuffers(window);
     ++frames;
-    if (automation && frames + 1 >= args.frames) {
+    if (automation && frames + 1 >= total_frames) {
       // Before the last frame: the full-size view, finished, with the panels hidden.
       session.request(requested);
       session.wait_idle();
@@ -672,10 +859,13 @@ int run(const Args& args) {
     write_screenshot(*full, view, args.screenshot, args.force);
     std::printf("wrote %s\n", args.screenshot.c_str());
   }
-  if (automation && !args.save_scene.empty()) {
-    save_scene(session, view, args.save_scene, args.force);
-    std::printf("wrote %s\n", args.save_scene.c_str());
+  if (automation && !args.save_map.empty()) {
+    session.save_map(args.save_map, args.force);
+    std::printf("wrote %s\n", args.save_map.c_str());
   }
+  if (automation && !args.save_scene.empty())
+    for (const std::string& f : save_scene(session, view.camera, view.display, view.keys, args.save_scene, args.force))
+      std::printf("wrote %s\n", f.c_str());
   if (automation) {
     std::printf("nebula-view: %d frames, bake %.3f s, last frame %.1f ms (%dx%d) on the %s\n", args.frames,
                 final_status.bake_seconds, final_status.frame_seconds * 1e3, view.camera.width, view.camera.height,
@@ -718,6 +908,19 @@ int main(int argc, char** argv) {
   app.add_option("--preview-photons", a.preview_photons,
                  "diffuse-field photons per band for the viewer's bakes, recorded in the scene (default: 65536 on "
                  "the CPU, the scene's on the GPU; 0: the scene's)");
+  app.add_option("--paint", a.paints,
+                 "x,r,radius,value[,plane]: a brush dab on an axial scene's map before the first frame (repeatable, "
+                 "in order): texel coordinates along the axis and from it, radius in texels, the value, tau_v (the "
+                 "default) or a band's emission")
+      ->allow_extra_args(false);
+  app.add_option("--paint-drag", a.paint_drag,
+                 "automation with --show-panels: x0,r0,x1,r1,radius,value: a mouse drag on the Axial map panel's "
+                 "image (texels), painted as the mouse paints, with the --brush-* options");
+  app.add_option("--brush-shape", a.brush_shape, "--paint's brush: round or square")->capture_default_str();
+  app.add_option("--brush-mode", a.brush_mode, "--paint's mode: set, add or erase (empties the texels)")->capture_default_str();
+  app.add_flag("--brush-soft", a.brush_soft, "--paint's brush falls off as 1 - d / radius");
+  app.add_option("--load-map", a.load_map, "an axial scene's map from HDF5 (tau_v, emission_<band>), before --paint");
+  app.add_option("--save-map", a.save_map, "automation: the (painted) map to HDF5, as [axial] file reads it");
   app.add_flag("--force", a.force, "overwrite existing outputs");
   app.add_flag("--show-panels", a.show_panels, "automation: keep the interface in the window shot");
   app.add_option("--table-photons", a.table_photons, "photons per row for tables generated on first use")

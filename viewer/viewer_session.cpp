@@ -6,10 +6,14 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
+#include "pipeline/axial_map_source.h"
+#include "reconstruct/reconstruct.h"
 #include "scene/scene_file.h"
 #include "viewer/demo_scene_text.h"
 
@@ -102,6 +106,20 @@ void set_view_overrides(SceneSource& s, const CameraSettings& c, const DisplaySe
                ", fov_deg = " + toml_number(k.fov_deg) + "}";
     s.set("animation", "{keyframes = [" + array + "]}");
   }
+}
+
+BrushPlane brush_plane(const Scene& scene, const std::string& name, const std::string& option) {
+  BrushPlane plane;
+  if (name == "tau_v") return plane;
+  std::string list;
+  for (size_t b = 0; b < scene.bands.size(); ++b) {
+    if (scene.bands[b] == name) {
+      plane.band = int(b);
+      return plane;
+    }
+    list += (list.empty() ? "" : ", ") + scene.bands[b];
+  }
+  throw Error(option + ": plane '" + name + "' is not tau_v or one of the scene's bands (" + list + ")");
 }
 
 // ------------------------------------------------------------ Session
@@ -239,6 +257,8 @@ void Session::sync_scene() {
 
 std::string Session::saved_scene_text(const CameraSettings& camera, const DisplaySettings& display,
                                       const std::vector<CameraKeyframe>& keys) const {
+  if (map_edited())
+    throw Error("the map was painted or loaded: the scene is saved with its map file (viewer::save_scene)");
   SceneSource s = source();
   set_view_overrides(s, camera, display, keys);
   std::shared_ptr<const Scene> shown;
@@ -249,6 +269,148 @@ std::string Session::saved_scene_text(const CameraSettings& camera, const Displa
   const Scene scene = s.load_reusing(*shown);
   return "# Saved by nebula-view from " + s.name() + " and its edits; `nebula render` reproduces the view.\n" +
          scene.resolved_toml + "\n";
+}
+
+// ------------------------------------------------------------ the axial map
+
+std::shared_ptr<const AxialMap> Session::axial_map() {
+  std::shared_ptr<const Scene> scene;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (painted_) return painted_;
+    scene = shown_scene_;
+  }
+  if (!scene->axial) throw Error("the scene has no [axial] map");
+  if (!built_ || built_for_ != scene) {
+    built_ = std::make_shared<const AxialMap>(build_axial_map(*scene));
+    built_for_ = scene;
+  }
+  return built_;
+}
+
+PaintResult Session::paint(Stroke stroke) {
+  const std::shared_ptr<const AxialMap> current = axial_map();
+  stroke.brush.n_bands = int(scene().bands.size());
+  AxialMap next = *current;  // the worker may be rendering the current one
+  const PaintResult result = paint_axial_map(next, stroke.brush, stroke.dabs);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    painted_ = std::make_shared<const AxialMap>(std::move(next));
+    ++wanted_version_;
+    why_ = "the map was painted";
+  }
+  wake_.notify_all();
+  return result;
+}
+
+void Session::load_map(const std::string& path) {
+  std::shared_ptr<const Scene> scene;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    scene = shown_scene_;
+  }
+  if (!scene->axial) throw Error(path + ": the scene has no [axial] map to replace");
+  AxialMap m;
+  m.tau_v = load_axial_plane_hdf5(path, "tau_v", m.nx, m.nr);
+  for (size_t b = 0; b < scene->bands.size(); ++b) {
+    const std::string name = kMapEmissionPrefix + scene->bands[b];
+    int nx = 0, nr = 0;
+    std::vector<float> plane;
+    try {
+      plane = load_axial_plane_hdf5(path, name, nx, nr, "emission");
+    } catch (const Error& e) {
+      // A file without emission datasets is a map of dust alone; one with some is checked whole.
+      const std::string what = e.what();
+      const size_t holds = what.find("(the file holds:");
+      if (b == 0 && holds != std::string::npos && what.find(kMapEmissionPrefix, holds) == std::string::npos) break;
+      throw;
+    }
+    if (nx != m.nx || nr != m.nr)
+      throw Error(path + ": dataset '" + name + "' is " + std::to_string(nr) + " x " + std::to_string(nx) +
+                  ", tau_v " + std::to_string(m.nr) + " x " + std::to_string(m.nx));
+    m.emission.push_back(std::move(plane));
+  }
+  AxialMap placed;
+  try {
+    placed = place_axial_map(*scene, std::move(m));
+  } catch (const Error& e) {
+    throw Error(path + ": " + e.what());
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    painted_ = std::make_shared<const AxialMap>(std::move(placed));
+    ++wanted_version_;
+    why_ = "the map was loaded from " + path;
+  }
+  wake_.notify_all();
+}
+
+void Session::save_map(const std::string& path, bool overwrite) {
+  const std::shared_ptr<const AxialMap> map = axial_map();
+  write_axial_map_hdf5(*map, scene().bands, path, overwrite, kMapEmissionPrefix);
+}
+
+bool Session::map_edited() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return painted_ != nullptr;
+}
+
+void Session::revert_map() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!painted_) return;
+    painted_.reset();
+    ++wanted_version_;
+    why_ = "the map was reverted to the scene's";
+  }
+  wake_.notify_all();
+}
+
+std::vector<std::string> save_scene(Session& session, const CameraSettings& camera, const DisplaySettings& display,
+                                    const std::vector<CameraKeyframe>& keys, const std::string& path, bool force) {
+  namespace fs = std::filesystem;
+  check_output_target(path, force, "folder", true);
+  const bool painted = session.map_edited();
+  const fs::path map_path = fs::path(path).parent_path() / (fs::path(path).stem().string() + ".map.h5");
+  if (painted) check_output_target(map_path.string(), force, "folder", true);
+  SceneSource source = session.source();
+  set_view_overrides(source, camera, display, keys);
+  const Scene scene = source.load_reusing(session.scene());
+  // Data files named relative to the scene's folder must stay findable (a
+  // painted map is written beside the saved scene instead of the scene's own).
+  const fs::path there = fs::absolute(fs::path(path)).parent_path().lexically_normal();
+  const fs::path here = fs::absolute(fs::path(source.base_dir())).lexically_normal();
+  for (const SceneInput& input : scene.inputs)
+    if (input.key != "scene" && there != here && !(painted && input.key.rfind("axial.", 0) == 0))
+      throw Error(path + ": save the scene in " + here.string() + ", the folder of " + source.name() + ": its " +
+                  input.key + " is named relative to it");
+  std::vector<std::string> written;
+  std::string text;
+  if (!painted) {
+    text = session.saved_scene_text(camera, display, keys);
+  } else {
+    const std::shared_ptr<const AxialMap> map = session.axial_map();
+    session.save_map(map_path.string(), force);
+    written.push_back(map_path.string());
+    const std::string body = scene_text_with_axial_file(scene.resolved_toml, map_path.filename().string(),
+                                                        map->emission.empty() ? "" : kMapEmissionPrefix);
+    try {
+      load_scene_text(body, path, there.string());  // as `nebula render` will read it
+    } catch (const Error& e) {
+      throw Error(path + ": the scene with its painted map does not load (a bug: please report it): " + e.what());
+    }
+    text = "# Saved by nebula-view from " + source.name() + ", its edits and its painted map " +
+           map_path.filename().string() + "; `nebula render` reproduces the view.\n" + body + "\n";
+  }
+  TemporaryFile temporary(path);
+  {
+    std::ofstream out(temporary.path(), std::ios::binary | std::ios::trunc);
+    out << text;
+    if (!out.flush()) throw Error("cannot write " + path);
+  }
+  temporary.publish();
+  written.push_back(path);
+  return written;
 }
 
 void Session::work() {
@@ -291,6 +453,7 @@ void Session::work() {
         t.backend = options_.backend;
         t.spp = 2;
         t.seed = uint64_t(pass) + 1;  // independent passes
+        t.axial_map = current->options.axial_map;
         const TruthRenderOutput out = truth_scene(scene, t);
         if (!sum) {
           sum = TruthFrame{};
@@ -331,6 +494,7 @@ void Session::work() {
       const SceneSource source = source_;
       const std::shared_ptr<const Scene> previous = latest_scene_;
       const std::shared_ptr<const Baked> reuse = baked_;
+      const std::shared_ptr<const AxialMap> painted = painted_;
       status_.activity = "baking (" + why_ + ")";
       status_.busy = true;
       lock.unlock();
@@ -344,6 +508,7 @@ void Session::work() {
         o.backend = options_.backend;
         o.table_photons = options_.table_photons;
         o.smooth_step = options_.smooth_step;
+        o.axial_map = painted;
         fresh = std::make_shared<Baked>(scene, o, reuse.get(), options_.preview_coarsening);
       } catch (const std::exception& e) {
         error = e.what();

@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "axial/axial_brush.h"
 #include "pipeline/render_scene.h"
 
 namespace nebula::viewer {
@@ -95,6 +96,23 @@ struct SessionStatus {
   bool busy = false;
 };
 
+// A brush stroke on an axial scene's map (axial/axial_brush.h): the brush and
+// its dabs in texel coordinates, painted in order (Session::paint sets
+// brush.n_bands to the scene's bands).
+struct Stroke {
+  Brush brush;
+  std::vector<BrushPoint> dabs;
+};
+
+// The plane a name paints: "tau_v", or one of the scene's band names (its
+// emission). Error "<option>: plane '<name>' is not tau_v or one of the
+// scene's bands (B, V, R)".
+BrushPlane brush_plane(const Scene& scene, const std::string& name, const std::string& option);
+
+// The datasets of a saved map (reconstruct/map_file.cpp's format, the one
+// `[axial] file` reads): "tau_v" and "emission_<band>".
+constexpr const char* kMapEmissionPrefix = "emission_";
+
 class Session {
  public:
   // Loads the scene now (Error on a bad one) and starts baking it in the background.
@@ -130,9 +148,27 @@ class Session {
   // Refreshes scene() after an edit finished (main thread; cheap when nothing changed).
   void sync_scene();
   // The scene as shown, with this view, as a TOML file `nebula render` reproduces:
-  // its resolved text with a comment line in front.
+  // its resolved text with a comment line in front. Error once the map was
+  // painted or loaded (save_scene writes the map beside the scene then).
   std::string saved_scene_text(const CameraSettings& camera, const DisplaySettings& display,
                                const std::vector<CameraKeyframe>& keys) const;
+
+  // The axial map (an [axial] scene only; Error otherwise): the painted or
+  // loaded one, else the scene's own as the renderer builds it (main thread).
+  std::shared_ptr<const AxialMap> axial_map();
+  // Paints a stroke on a copy of the map and renders the scene with it (the
+  // worker re-renders in the background, the previous frame shown meanwhile).
+  // Error naming the brush's field for a bad brush, or for a scene that is
+  // not axial; the map is unchanged then.
+  PaintResult paint(Stroke stroke);
+  // Replaces the map by an HDF5 file's (tau_v, and emission_<band> for every
+  // band when the file has them), placed by the scene's axial.length_pc,
+  // origin and axis. Error naming the file; nothing changes then.
+  void load_map(const std::string& path);
+  // Writes the map as load_map and `[axial] file` read it (written aside, then renamed).
+  void save_map(const std::string& path, bool overwrite);
+  bool map_edited() const;  // painted or loaded since the scene's own map
+  void revert_map();        // back to the scene's own map
 
  private:
   struct Baked;
@@ -155,8 +191,19 @@ class Session {
   bool truth_on_ = false;
   std::optional<CameraSettings> truth_camera_;  // the last view rendered
   std::optional<TruthFrame> truth_;
+  std::shared_ptr<const AxialMap> painted_;          // set: rendered instead of the scene's map
+  std::shared_ptr<const AxialMap> built_;            // the scene's own map, for painting (main thread)
+  std::shared_ptr<const Scene> built_for_;           // the scene built_ was built from
   SessionStatus status_;
   std::thread thread_;
 };
+
+// Writes the scene as the viewer shows it to `path` (TOML, written aside and
+// renamed; `nebula render` reproduces the view). With the map painted or
+// loaded, the map goes first to PATH's stem + ".map.h5" beside it, and the
+// scene's [axial] table reads it (scene_text_with_axial_file). Returns the
+// files written. Errors name the file; nothing is written for a refused target.
+std::vector<std::string> save_scene(Session& session, const CameraSettings& camera, const DisplaySettings& display,
+                                    const std::vector<CameraKeyframe>& keys, const std::string& path, bool force);
 
 }  // namespace nebula::viewer

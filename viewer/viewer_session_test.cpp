@@ -1,11 +1,13 @@
 // The viewer without a window: the background bake and render, edits that
-// change the picture as they should, a bad edit undone, and the saved scene
-// rendering the viewer's frame again bit for bit.
+// change the picture as they should, a bad edit undone, the saved scene
+// rendering the viewer's frame again bit for bit, and painting an axial map.
 #include "viewer/viewer_session.h"
 
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <chrono>
 #include <cmath>
 #include <numeric>
@@ -236,6 +238,142 @@ TEST_F(ViewerSession, TheWindowShowsWhatAPngHolds) {
       for (int c = 0; c < 3; ++c)
         ASSERT_EQ(int(std::lround(png.at(c, x, y) * 255)), int(rgba.pixels[(size_t(y) * png.width + x) * 4 + c]))
             << x << " " << y << " " << c;
+}
+
+// An axial scene with an empty map and a star on the axis at its middle: black
+// (no dust to scatter, no emission, stars not drawn) until dust is painted.
+const char* kAxialScene = R"(
+bands = ["B", "V", "R"]
+[axial]
+synthetic = "empty"
+nx = 64
+nr = 32
+length_pc = 2.0
+origin = [0.0, 0.0, -1.0]
+[[stars]]
+position = [0.0, 0.0, 0.0]
+luminosity_lsun = 2e4
+class = "B0V"
+[camera]
+position = [6.0, 0.0, 0.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 0.0, 1.0]
+fov_deg = 30
+width = 24
+height = 24
+[render]
+diffuse_photons = 8192
+)";
+
+// Sums of the rows above and below the image's middle (camera up = +z = the axis).
+std::pair<double, double> upper_lower(const Image& image) {
+  double up = 0, down = 0;
+  for (int c = 0; c < int(image.bands.size()); ++c)
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x) (y < image.height / 2 ? up : down) += image.at(c, x, y);
+  return {up, down};
+}
+
+Stroke dust_ring() {
+  // A ring of tau_v 0.3 per texel around the axis 0.25 pc above the star
+  // (texel 1/32 pc: x = 40 is z = +0.25, r = 8 texels 0.25 pc).
+  Stroke s;
+  s.brush.radius = 4;
+  s.brush.value = 0.3f;
+  s.dabs = {{40.5f, 8.5f}};
+  return s;
+}
+
+TEST_F(ViewerSession, PaintedDustLightsUpWhereItWasPaintedAndErasingDarkensAgain) {
+  Session s(SceneSource(kAxialScene, path("axial.toml"), dir_.string()), options());
+  const CameraSettings camera = s.scene().camera;
+  const Frame empty = frame_of(s, camera);
+  EXPECT_EQ(total(empty.image), 0.0);
+  EXPECT_FALSE(s.map_edited());
+
+  const uint64_t version = s.status().version;
+  const PaintResult r = s.paint(dust_ring());
+  EXPECT_EQ(r.texels, 49u);  // lattice points within 4 of a point: 49
+  EXPECT_TRUE(s.map_edited());
+  EXPECT_EQ(s.axial_map()->empty_texels, s.axial_map()->count() - 49);
+  const Frame painted = frame_of(s, camera);
+  EXPECT_GT(painted.version, version);
+  const auto [up, down] = upper_lower(painted.image);
+  EXPECT_GT(up, 0.0);
+  EXPECT_GT(up, 20 * down) << "the ring lies above the star: the light above the middle";
+
+  Stroke erase;
+  erase.brush.mode = BrushMode::Erase;
+  erase.brush.shape = BrushShape::Square;
+  erase.brush.radius = 100;
+  erase.dabs = {{32, 16}};
+  s.paint(erase);
+  EXPECT_EQ(s.axial_map()->empty_texels, s.axial_map()->count());
+  EXPECT_EQ(total(frame_of(s, camera).image), 0.0);
+
+  s.revert_map();
+  EXPECT_FALSE(s.map_edited());
+}
+
+TEST_F(ViewerSession, ThePaintedSceneSavedWithItsMapRendersTheSameImage) {
+  Session s(SceneSource(kAxialScene, path("axial.toml"), dir_.string()), options());
+  s.paint(dust_ring());
+  Stroke glow;  // emission of band R alone, below the star
+  glow.brush.radius = 3;
+  glow.brush.value = 0.01f;
+  glow.brush.plane.band = 2;
+  glow.dabs = {{20.5f, 4.5f}};
+  s.paint(glow);
+  CameraSettings camera = s.scene().camera;
+  camera.position = {5.0f, 1.0f, 2.0f};
+  const Frame shown = frame_of(s, camera);
+  ASSERT_GT(total(shown.image), 0.0);
+  testing::expect_error([&] { s.saved_scene_text(camera, {}, {}); }, {"painted"});
+
+  const std::vector<std::string> written = save_scene(s, camera, {}, {}, path("saved.toml"), false);
+  ASSERT_EQ(written.size(), 2u);
+  EXPECT_EQ(written[0], path("saved.map.h5"));
+  EXPECT_EQ(written[1], path("saved.toml"));
+  const Scene saved = load_scene(path("saved.toml"));
+  ASSERT_TRUE(saved.axial.has_value());
+  EXPECT_EQ(saved.axial->source, "file");
+  EXPECT_EQ(saved.axial->path, path("saved.map.h5"));
+  RenderOptions o;
+  o.table_photons = 1000;
+  const RenderOutput rendered = render_scene(saved, o);
+  EXPECT_EQ(rendered.image.pixels, shown.image.pixels);
+
+  // Saving again without --force: refused before anything is written.
+  testing::expect_error([&] { save_scene(s, camera, {}, {}, path("saved.toml"), false); }, {"saved"});
+
+  // The map file loads into a fresh session's empty map: the same frame.
+  Session t(SceneSource(kAxialScene, path("axial.toml"), dir_.string()), options());
+  t.load_map(path("saved.map.h5"));
+  EXPECT_TRUE(t.map_edited());
+  EXPECT_EQ(t.axial_map()->emission.size(), 3u);
+  EXPECT_EQ(frame_of(t, camera).image.pixels, shown.image.pixels);
+}
+
+TEST_F(ViewerSession, BadMapsAndBrushesAreRefusedAndChangeNothing) {
+  Session s(SceneSource(kAxialScene, path("axial.toml"), dir_.string()), options());
+  {
+    std::ofstream junk(path("junk.h5"));
+    junk << "not HDF5";
+  }
+  testing::expect_error([&] { s.load_map(path("junk.h5")); }, {"junk.h5"});
+  testing::expect_error([&] { s.load_map(path("missing.h5")); }, {"missing.h5"});
+  Stroke bad = dust_ring();
+  bad.brush.plane.band = 3;
+  testing::expect_error([&] { s.paint(bad); }, {"brush: plane"});
+  EXPECT_FALSE(s.map_edited());
+  EXPECT_EQ(s.axial_map()->empty_texels, s.axial_map()->count());
+  testing::expect_error([&] { brush_plane(s.scene(), "Ha", "--paint '1,2,3,4,Ha'"); },
+                        {"--paint '1,2,3,4,Ha'", "plane 'Ha'", "B, V, R"});
+  EXPECT_EQ(brush_plane(s.scene(), "V", "x").band, 1);
+  EXPECT_TRUE(brush_plane(s.scene(), "tau_v", "x").is_tau());
+
+  Session grid(SceneSource(kScene, "v.toml", "."), options());
+  testing::expect_error([&] { grid.paint(dust_ring()); }, {"no [axial] map"});
 }
 
 }  // namespace
