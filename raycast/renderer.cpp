@@ -3,13 +3,16 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstring>
 
 #include "core/error.h"
 #include "core/placement.h"
 #include "core/progress.h"
 #include "raycast/diffuse_light.h"
+#include "raycast/host_copy.h"
 #include "raycast/march_scene.h"
 #include "raycast/voxel_sources.h"
 
@@ -103,6 +106,16 @@ Image render_cpu(const RenderInputs& in, RenderStats* stats) {
     stats->table_clamps = clamps;
   }
   return image;
+}
+
+void parallel_copy(float* to, const float* from, size_t n) {
+  constexpr size_t kChunk = size_t(1) << 18;  // 1 MiB of floats per task
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, (n + kChunk - 1) / kChunk), [&](const auto& chunks) {
+    for (size_t c = chunks.begin(); c != chunks.end(); ++c) {
+      const size_t begin = c * kChunk, count = std::min(kChunk, n - begin);
+      std::memcpy(to + begin, from + begin, count * sizeof(float));
+    }
+  });
 }
 
 Image render(const RenderInputs& in, Backend backend, RenderStats* stats) {

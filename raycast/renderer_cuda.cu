@@ -12,6 +12,7 @@
 #include "core/device_placement.h"
 #include "core/frame_pool.h"
 #include "raycast/diffuse_light.h"
+#include "raycast/host_copy.h"
 #include "raycast/march_scene.h"
 #include "raycast/renderer.h"
 #include "raycast/voxel_sources.h"
@@ -79,9 +80,30 @@ T* reused(std::unique_ptr<DeviceArray<T>>& slot, size_t n) {
   }
   return slot->get();
 }
+// Page-locked host memory for a frame's download: the copy engine writes it at
+// the bus's speed (a pageable destination is staged by the driver at about a
+// third of it), then every core copies it into the frame.
+struct PinnedStaging {
+  float* data = nullptr;
+  size_t size = 0;
+  float* get(size_t n) {
+    if (n > size) {
+      if (data) cudaFreeHost(data);
+      data = nullptr;
+      size = 0;
+      NEBULA_CUDA_CHECK(cudaMallocHost(&data, n * sizeof(float)));
+      size = n;
+    }
+    return data;
+  }
+  ~PinnedStaging() {
+    if (data) cudaFreeHost(data);
+  }
+};
 struct FrameBuffers {
   std::unique_ptr<DeviceArray<float>> pixels, light[kMaxBands];
   std::unique_ptr<DeviceArray<unsigned long long>> clamps;
+  PinnedStaging staging;
 };
 thread_local FrameBuffers frame_buffers;
 
@@ -137,7 +159,9 @@ Image render_cuda(const RenderInputs& in, RenderStats* stats) {
   NEBULA_CUDA_CHECK(cudaMemset(pixels, 0, image.pixels.size() * sizeof(float)));
   NEBULA_CUDA_CHECK(cudaMemset(clamps, 0, sizeof(unsigned long long)));
   const double seconds = render_cuda_to_device(in, pixels, clamps);
-  NEBULA_CUDA_CHECK(cudaMemcpy(image.pixels.data(), pixels, image.pixels.size() * sizeof(float), cudaMemcpyDeviceToHost));
+  float* staging = frame_buffers.staging.get(image.pixels.size());
+  NEBULA_CUDA_CHECK(cudaMemcpy(staging, pixels, image.pixels.size() * sizeof(float), cudaMemcpyDeviceToHost));
+  parallel_copy(image.pixels.data(), staging, image.pixels.size());
   if (stats) {
     unsigned long long count = 0;
     NEBULA_CUDA_CHECK(cudaMemcpy(&count, clamps, sizeof count, cudaMemcpyDeviceToHost));

@@ -1,4 +1,5 @@
 #include "raycast/renderer.h"
+#include "raycast/host_copy.h"
 
 #include <gtest/gtest.h>
 
@@ -370,6 +371,21 @@ TEST(PointStars, EveryCameraKindConservesTheStarsLight) {
     const double expected =
         2.0 / (4 * kPiD) * std::exp(-tau) / (kind == Projection::Orthographic ? 1.0 : r2);
     EXPECT_NEAR(total / expected, 1.0, 0.01) << to_string(kind);
+  }
+}
+
+}  // namespace
+}  // namespace nebula
+
+namespace nebula {
+namespace {
+
+TEST(ParallelCopy, CopiesEveryValueWhateverTheSize) {
+  for (size_t n : {size_t(0), size_t(1), size_t(1) << 18, (size_t(3) << 18) + 7}) {
+    std::vector<float> from(n), to(n, -1.0f);
+    for (size_t i = 0; i < n; ++i) from[i] = float(i % 1009) * 0.5f;
+    parallel_copy(to.data(), from.data(), n);
+    EXPECT_EQ(to, from) << n;
   }
 }
 
