@@ -22,6 +22,7 @@ spectral::SpectralMethod method_of(const std::string& name) {
   if (name == "double") return spectral::SpectralMethod::Double;
   if (name == "analytic") return spectral::SpectralMethod::Analytic;
   if (name == "light_density") return spectral::SpectralMethod::LightBasis;
+  if (name == "voxel_light") return spectral::SpectralMethod::VoxelLight;
   return spectral::SpectralMethod::Projection;
 }
 

@@ -118,7 +118,7 @@ struct SceneFilter {
 // power per band. Single scattering in each voxel (the thin-voxel HG phase
 // function), no tables, no light between voxels.
 struct SpectralSpec {
-  std::string method = "projection";  // double, analytic, projection, light_density
+  std::string method = "projection";  // double, analytic, projection, light_density, voxel_light
   int basis = 4;                      // elements of the greedy basis, 1..16
   int wavelengths = 20;               // double: wavelength samples, 2..4096
   std::string attenuation = "law";    // law (dust.law, dust.R_V) or inverse (C_T / lambda, the report's)
