@@ -178,77 +178,102 @@ NEBULA_HD const float* star_integrals(const SpectralSceneView& s, int k, size_t 
   return s.star_coeff + (size_t(k) * s.n_depth + d0) * (s.n_acc * s.n_basis);
 }
 
-// u[4][FN] += (w, grad) times the star's row q interpolated at fd (restrict:
-// the table and the voxel's light never overlap, so the loop vectorises).
-NEBULA_HD void add_star_light(float* __restrict__ u, const float* __restrict__ q, int FN, float fd, float w, Vec3 grad) {
-  for (int i = 0; i < FN; ++i) {
-    const float v = q[i] + fd * (q[FN + i] - q[i]);
-    u[i] += w * v;
-    u[FN + i] += grad.x * v;
-    u[2 * FN + i] += grad.y * v;
-    u[3 * FN + i] += grad.z * v;
-  }
-}
-
-// VoxelLight's per-view pre-pass for one voxel: U = a tau_V sum_k L_k/(4 pi r^2)
-// p_HG(mu) Q(star k, D_k) at the voxel's centre and its gradient (analytic:
-// 1/r^2 and mu, with the direction to the eye varying across the voxel as the
-// rays through it do), into light[cell][4][F N]; near[cell] the stars taken
-// exactly instead. Cost: voxels x stars, once per view.
-NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int x, int y, int z, float* light,
+// VoxelLight's per-view pre-pass for voxels x0 .. x0 + kRow - 1 (those below
+// the grid's edge) of row (y, z): U = a tau_V sum_k L_k/(4 pi r^2) p_HG(mu)
+// Q(star k, D_k) at each voxel's centre and its gradient (analytic: 1/r^2 and
+// mu, with the direction to the eye varying across the voxel as the rays
+// through it do), into light[cell][4][F N]; near[cell] bit k: star k's pair
+// taken exactly in the march instead. Cost: voxels x stars, once per view.
+// First each star's weight and gradient per voxel (kRow voxels side by side,
+// branch-free), then each output summed over the stars in registers and
+// written once (no read-modify-write of the voxel's light per star). The CPU
+// runs rows of 16 voxels, the GPU one voxel per thread (kRow 1).
+template <int kRow>
+NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int x0, int y, int z, float* light,
                            unsigned* near) {
   const GridShape& g = s.density.shape;
-  const size_t cell = g.index(x, y, z);
+  const int n = g.nx - x0 < kRow ? g.nx - x0 : kRow;
+  const size_t cell0 = g.index(x0, y, z);
   const int FN = s.n_acc * s.n_basis;
-  float* u = light + cell * 4 * FN;
-  for (int i = 0; i < 4 * FN; ++i) u[i] = 0.0f;
-  unsigned mask = 0;
-  const float tau_v = s.density.tau_v[cell];
-  if (tau_v > 0.0f) {
-    const Vec3 centre = g.centre(x, y, z);
+  const Vec3 c0 = g.centre(x0, y, z);
+  float ex[kRow], ey[kRow], ez[kRow], inv_rho[kRow], tau[kRow];
+  for (int i = 0; i < n; ++i) {
+    const Vec3 centre{c0.x + float(i) * g.voxel, c0.y, c0.z};
     const Vec3 e = camera.to_eye(centre);
+    ex[i] = e.x;
+    ey[i] = e.y;
+    ez[i] = e.z;
     // 1 / distance to the eye: the rays' direction turns by (offset / distance) across the voxel.
     const float rho = length(camera.position - centre);
-    const float inv_rho = camera.projection == Projection::Orthographic || !(rho > 0.0f) ? 0.0f : 1.0f / rho;
-    const float near2 = 0.5f * s.near_distance * s.near_distance, g2 = s.g * s.g;
-    const float phase_norm = (1.0f - g2) * kInv4Pi, inv_step = 1.0f / s.depth_step;
-    // The curvature's largest value over mu in [-1, 1], at mu = sign(g): 2 + 3|g| / (1 - |g|)^2.
-    const float ag = fabsf(s.g), max_curvature = 2.0f + 3.0f * ag / ((1.0f - ag) * (1.0f - ag)) + 1e-3f;
-    for (int k = 0; k < s.n_stars; ++k) {
-      const Vec3 d = centre - s.stars[k].position;
-      const float r2_raw = dot(d, d);
-      const float inv_r = r2_raw > 0.0f ? 1.0f / sqrtf(r2_raw) : 0.0f;
-      const Vec3 dh = r2_raw > 0.0f ? inv_r * d : e;
-      const float mu = dot(dh, e);
+    inv_rho[i] = camera.projection == Projection::Orthographic || !(rho > 0.0f) ? 0.0f : 1.0f / rho;
+    tau[i] = s.density.tau_v[cell0 + i];
+  }
+  const float near2 = 0.5f * s.near_distance * s.near_distance, g2 = s.g * s.g;
+  const float phase_norm = (1.0f - g2) * kInv4Pi * s.albedo, inv_step = 1.0f / s.depth_step;
+  const float last = float(s.n_depth - 1);
+  // Per star and voxel: weight, its gradient, the table position; the near mask.
+  float w[kMaxVoxelLightStars][kRow], gx[kMaxVoxelLightStars][kRow], gy[kMaxVoxelLightStars][kRow],
+      gz[kMaxVoxelLightStars][kRow], xd[kMaxVoxelLightStars][kRow];
+  unsigned mask[kRow];
+  for (int i = 0; i < n; ++i) mask[i] = 0;
+  for (int k = 0; k < s.n_stars; ++k) {
+    const Vec3 star = s.stars[k].position;
+    const float* depth = s.stars[k].depth_v + cell0;
+    const float power = s.stars[k].power * kInv4Pi * phase_norm;
+    for (int i = 0; i < n; ++i) {  // branch-free: arithmetic and masks, no early exits
+      const float dx = c0.x + float(i) * g.voxel - star.x, dy = c0.y - star.y, dz = c0.z - star.z;
+      const float r2 = dx * dx + dy * dy + dz * dz;
+      const float inv_r = 1.0f / sqrtf(r2 + 1e-30f);
+      const float hx = dx * inv_r, hy = dy * inv_r, hz = dz * inv_r;
+      const float mu = hx * ex[i] + hy * ey[i] + hz * ez[i];
       // The expansion's error is second order, (offset / r)^2 times the curvature of ln w
       // in the angle seen from the star: 2 for 1/r^2, plus the phase's |d^2 ln p / d theta^2|
       // (3g / (1 - g)^2 in forward scattering: 11 at g = 0.6). near_distance holds for
       // the curvature 2 of 1/r^2 alone; a sharper phase widens it as the square root.
       const float A = 1.0f + g2 - 2.0f * s.g * mu, inv_A = 1.0f / A;
-      if (r2_raw < near2 * max_curvature) {  // rare: only then the curvature itself
-        const float curvature = 2.0f + fabsf(3.0f * s.g * (mu * A - 2.0f * s.g * (1.0f - mu * mu))) * inv_A * inv_A;
-        if (r2_raw < near2 * curvature) {
-          mask |= 1u << k;
-          continue;
-        }
-      }
-      const float x_d = s.stars[k].depth_v[cell] * inv_step;
-      if (!(x_d < float(s.n_depth - 1))) continue;  // beyond the table: below the transmittance cut
-      const int d0 = int(x_d);
-      const float* q = s.star_coeff + (size_t(k) * s.n_depth + d0) * FN;
+      const float curvature = 2.0f + fabsf(3.0f * s.g * (mu * A - 2.0f * s.g * (1.0f - mu * mu))) * inv_A * inv_A;
+      const bool close = r2 < near2 * curvature;
+      const float x = depth[i] * inv_step;
+      // Bitwise, not &&: no branch (beyond the table: below the transmittance cut).
+      const bool take = (tau[i] > 0.0f) & !close & (x < last);
       // r^2 softened by the pixel's footprint at the star, as chord_irradiance does (a ray
       // stands for its pixel): 1 / (r^2 + w^2 / (4 pi)).
-      const float t_star = -dot(s.stars[k].position - camera.position, e);
-      const float width = s.footprint.width_at_eye + (t_star > 0.0f ? t_star : 0.0f) * s.footprint.spread;
-      const float inv_r2 = 1.0f / (r2_raw + width * width * kInv4Pi);
-      const float w = s.stars[k].power * kInv4Pi * inv_r2 * s.albedo * tau_v * phase_norm * inv_A * sqrtf(inv_A);
-      // grad ln w = -2 d / r2 + (d ln p / d mu) grad mu.
-      const Vec3 grad_mu = inv_r * (e - mu * dh) - inv_rho * (dh - mu * e);
-      const Vec3 grad = w * ((-2.0f * inv_r2) * d + (3.0f * s.g * inv_A) * grad_mu);
-      add_star_light(u, q, FN, x_d - float(d0), w, grad);
+      const float t_star = (camera.position.x - star.x) * ex[i] + (camera.position.y - star.y) * ey[i] +
+                           (camera.position.z - star.z) * ez[i];
+      const float width = s.footprint.width_at_eye + 0.5f * (t_star + fabsf(t_star)) * s.footprint.spread;
+      const float inv_r2 = 1.0f / (r2 + width * width * kInv4Pi);
+      const float wi = power * tau[i] * inv_r2 * inv_A * sqrtf(inv_A) * float(take);
+      // grad ln w = -2 d / r2 + (d ln p / d mu) grad mu, grad mu = (e - mu h) / r - (h - mu e) / rho.
+      const float a = -2.0f * inv_r2, b = 3.0f * s.g * inv_A;
+      gx[k][i] = wi * (a * dx + b * (inv_r * (ex[i] - mu * hx) - inv_rho[i] * (hx - mu * ex[i])));
+      gy[k][i] = wi * (a * dy + b * (inv_r * (ey[i] - mu * hy) - inv_rho[i] * (hy - mu * ey[i])));
+      gz[k][i] = wi * (a * dz + b * (inv_r * (ez[i] - mu * hz) - inv_rho[i] * (hz - mu * ez[i])));
+      w[k][i] = wi;
+      xd[k][i] = x * float(take);
+      mask[i] |= unsigned((tau[i] > 0.0f) & close) << k;
     }
   }
-  near[cell] = mask;
+  for (int i = 0; i < n; ++i) {
+    float* u = light + (cell0 + i) * 4 * FN;
+    for (int j = 0; j < FN; ++j) {
+      float a0 = 0.0f, a1 = 0.0f, a2 = 0.0f, a3 = 0.0f;
+      for (int k = 0; k < s.n_stars; ++k) {
+        if (w[k][i] == 0.0f) continue;
+        const int d0 = int(xd[k][i]);
+        const float* q = s.star_coeff + (size_t(k) * s.n_depth + d0) * FN + j;
+        const float v = q[0] + (xd[k][i] - float(d0)) * (q[FN] - q[0]);
+        a0 += w[k][i] * v;
+        a1 += gx[k][i] * v;
+        a2 += gy[k][i] * v;
+        a3 += gz[k][i] * v;
+      }
+      u[j] = a0;
+      u[FN + j] = a1;
+      u[2 * FN + j] = a2;
+      u[3 * FN + j] = a3;
+    }
+    near[cell0 + i] = mask[i];
+  }
 }
 
 // One ray: the accumulators (n_acc of them) before the resolve.

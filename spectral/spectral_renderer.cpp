@@ -54,9 +54,11 @@ Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds) {
   }
   const auto start = std::chrono::steady_clock::now();
   if (m.settings.method == SpectralMethod::VoxelLight) {  // the per-view pre-pass (timed with the march)
+    constexpr int kRow = 16;  // voxels side by side in the vectorised geometry
     tbb::parallel_for(tbb::blocked_range<int>(0, g.nz * g.ny), [&](const auto& rows) {
       for (int r = rows.begin(); r != rows.end(); ++r)
-        for (int x = 0; x < g.nx; ++x) voxel_light(view, in.camera, x, r % g.ny, r / g.ny, work.light.data(), work.near.data());
+        for (int x = 0; x < g.nx; x += kRow)
+          voxel_light<kRow>(view, in.camera, x, r % g.ny, r / g.ny, work.light.data(), work.near.data());
     });
     view.voxel_light = work.light.data();
     view.near_stars = work.near.data();

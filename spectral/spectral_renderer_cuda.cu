@@ -34,7 +34,7 @@ __global__ void voxel_light_kernel(SpectralSceneView scene, Camera camera, float
   const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i >= g.count()) return;
   const int x = int(i % g.nx), y = int((i / g.nx) % g.ny), z = int(i / (size_t(g.nx) * g.ny));
-  voxel_light(scene, camera, x, y, z, light, near);
+  voxel_light<1>(scene, camera, x, y, z, light, near);
 }
 
 template <class T>
