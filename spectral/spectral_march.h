@@ -178,6 +178,19 @@ NEBULA_HD const float* star_integrals(const SpectralSceneView& s, int k, size_t 
   return s.star_coeff + (size_t(k) * s.n_depth + d0) * (s.n_acc * s.n_basis);
 }
 
+// u[4][FN] += (w, grad) times the star's row q interpolated at fd (restrict:
+// the table and the voxel's light never overlap, so the loop vectorises). The
+// same sums, in the same order, as the GPU's per-output loop below.
+NEBULA_HD void add_star_light(float* __restrict__ u, const float* __restrict__ q, int FN, float fd, float w, Vec3 grad) {
+  for (int i = 0; i < FN; ++i) {
+    const float v = q[i] + fd * (q[FN + i] - q[i]);
+    u[i] += w * v;
+    u[FN + i] += grad.x * v;
+    u[2 * FN + i] += grad.y * v;
+    u[3 * FN + i] += grad.z * v;
+  }
+}
+
 // VoxelLight's per-view pre-pass for voxels x0 .. x0 + kRow - 1 (those below
 // the grid's edge) of row (y, z): U = a tau_V sum_k L_k/(4 pi r^2) p_HG(mu)
 // Q(star k, D_k) at each voxel's centre and its gradient (analytic: 1/r^2 and
@@ -185,9 +198,10 @@ NEBULA_HD const float* star_integrals(const SpectralSceneView& s, int k, size_t 
 // through it do), into light[cell][4][F N]; near[cell] bit k: star k's pair
 // taken exactly in the march instead. Cost: voxels x stars, once per view.
 // First each star's weight and gradient per voxel (kRow voxels side by side,
-// branch-free), then each output summed over the stars in registers and
-// written once (no read-modify-write of the voxel's light per star). The CPU
-// runs rows of 16 voxels, the GPU one voxel per thread (kRow 1).
+// branch-free: vectorised on the CPU), then the sums over the stars. The CPU
+// runs rows of 16 voxels, the GPU one voxel per thread (kRow 1), summing each
+// output in registers and writing it once (no read-modify-write per star in
+// global memory).
 template <int kRow>
 NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int x0, int y, int z, float* light,
                            unsigned* near) {
@@ -213,9 +227,7 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
   const float last = float(s.n_depth - 1);
   // Per star and voxel: weight, its gradient, the table position; the near mask.
   float w[kMaxVoxelLightStars][kRow], gx[kMaxVoxelLightStars][kRow], gy[kMaxVoxelLightStars][kRow],
-      gz[kMaxVoxelLightStars][kRow], xd[kMaxVoxelLightStars][kRow];
-  unsigned mask[kRow];
-  for (int i = 0; i < n; ++i) mask[i] = 0;
+      gz[kMaxVoxelLightStars][kRow], xd[kMaxVoxelLightStars][kRow], is_near[kMaxVoxelLightStars][kRow];
   for (int k = 0; k < s.n_stars; ++k) {
     const Vec3 star = s.stars[k].position;
     const float* depth = s.stars[k].depth_v + cell0;
@@ -232,47 +244,60 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
       // the curvature 2 of 1/r^2 alone; a sharper phase widens it as the square root.
       const float A = 1.0f + g2 - 2.0f * s.g * mu, inv_A = 1.0f / A;
       const float curvature = 2.0f + fabsf(3.0f * s.g * (mu * A - 2.0f * s.g * (1.0f - mu * mu))) * inv_A * inv_A;
-      const bool close = r2 < near2 * curvature;
+      const float lit = tau[i] > 0.0f ? 1.0f : 0.0f;
+      const float close = r2 < near2 * curvature ? lit : 0.0f;
       const float x = depth[i] * inv_step;
-      // Bitwise, not &&: no branch (beyond the table: below the transmittance cut).
-      const bool take = (tau[i] > 0.0f) & !close & (x < last);
+      // Products of 0/1 flags, not &&: no branch (beyond the table: below the transmittance cut).
+      const float take = (lit - close) * (x < last ? 1.0f : 0.0f);
       // r^2 softened by the pixel's footprint at the star, as chord_irradiance does (a ray
       // stands for its pixel): 1 / (r^2 + w^2 / (4 pi)).
       const float t_star = (camera.position.x - star.x) * ex[i] + (camera.position.y - star.y) * ey[i] +
                            (camera.position.z - star.z) * ez[i];
       const float width = s.footprint.width_at_eye + 0.5f * (t_star + fabsf(t_star)) * s.footprint.spread;
       const float inv_r2 = 1.0f / (r2 + width * width * kInv4Pi);
-      const float wi = power * tau[i] * inv_r2 * inv_A * sqrtf(inv_A) * float(take);
+      const float wi = power * tau[i] * inv_r2 * inv_A * sqrtf(inv_A) * take;
       // grad ln w = -2 d / r2 + (d ln p / d mu) grad mu, grad mu = (e - mu h) / r - (h - mu e) / rho.
       const float a = -2.0f * inv_r2, b = 3.0f * s.g * inv_A;
       gx[k][i] = wi * (a * dx + b * (inv_r * (ex[i] - mu * hx) - inv_rho[i] * (hx - mu * ex[i])));
       gy[k][i] = wi * (a * dy + b * (inv_r * (ey[i] - mu * hy) - inv_rho[i] * (hy - mu * ey[i])));
       gz[k][i] = wi * (a * dz + b * (inv_r * (ez[i] - mu * hz) - inv_rho[i] * (hz - mu * ez[i])));
       w[k][i] = wi;
-      xd[k][i] = x * float(take);
-      mask[i] |= unsigned((tau[i] > 0.0f) & close) << k;
+      xd[k][i] = x * take;
+      is_near[k][i] = close;
     }
   }
   for (int i = 0; i < n; ++i) {
     float* u = light + (cell0 + i) * 4 * FN;
-    for (int j = 0; j < FN; ++j) {
-      float a0 = 0.0f, a1 = 0.0f, a2 = 0.0f, a3 = 0.0f;
+    if constexpr (kRow == 1) {  // GPU: each output summed over the stars in registers, written once
+      for (int j = 0; j < FN; ++j) {
+        float a0 = 0.0f, a1 = 0.0f, a2 = 0.0f, a3 = 0.0f;
+        for (int k = 0; k < s.n_stars; ++k) {
+          if (w[k][i] == 0.0f) continue;
+          const int d0 = int(xd[k][i]);
+          const float* q = s.star_coeff + (size_t(k) * s.n_depth + d0) * FN + j;
+          const float v = q[0] + (xd[k][i] - float(d0)) * (q[FN] - q[0]);
+          a0 += w[k][i] * v;
+          a1 += gx[k][i] * v;
+          a2 += gy[k][i] * v;
+          a3 += gz[k][i] * v;
+        }
+        u[j] = a0;
+        u[FN + j] = a1;
+        u[2 * FN + j] = a2;
+        u[3 * FN + j] = a3;
+      }
+    } else {  // CPU: star by star, the outputs contiguous (vectorised; the voxel's light stays in cache)
+      for (int j = 0; j < 4 * FN; ++j) u[j] = 0.0f;
       for (int k = 0; k < s.n_stars; ++k) {
         if (w[k][i] == 0.0f) continue;
         const int d0 = int(xd[k][i]);
-        const float* q = s.star_coeff + (size_t(k) * s.n_depth + d0) * FN + j;
-        const float v = q[0] + (xd[k][i] - float(d0)) * (q[FN] - q[0]);
-        a0 += w[k][i] * v;
-        a1 += gx[k][i] * v;
-        a2 += gy[k][i] * v;
-        a3 += gz[k][i] * v;
+        add_star_light(u, s.star_coeff + (size_t(k) * s.n_depth + d0) * FN, FN, xd[k][i] - float(d0), w[k][i],
+                       Vec3{gx[k][i], gy[k][i], gz[k][i]});
       }
-      u[j] = a0;
-      u[FN + j] = a1;
-      u[2 * FN + j] = a2;
-      u[3 * FN + j] = a3;
     }
-    near[cell0 + i] = mask[i];
+    unsigned mask = 0;
+    for (int k = 0; k < s.n_stars; ++k) mask |= unsigned(is_near[k][i] != 0.0f) << k;
+    near[cell0 + i] = mask;
   }
 }
 
