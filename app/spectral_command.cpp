@@ -124,6 +124,7 @@ void add_spectral_bench(CLI::App* bench) {
     std::string backends = "auto", scene, json, attenuation = "inverse";
     std::vector<std::string> overrides;
     int size = 64, width = 256, height = 256, repeats = 3, stars = 1, reference = 400;
+    double near_voxels = spectral::SpectralSettings{}.near_voxels;
     float tau = 4.0f;
     bool quick = false;
     std::vector<std::string> filters{"B", "V", "R"};
@@ -146,6 +147,9 @@ void add_spectral_bench(CLI::App* bench) {
       ->capture_default_str()
       ->check(CLI::Range(2, 4096));
   cmd->add_option("--repeats", o->repeats)->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_option("--near-voxels", o->near_voxels, "voxel light: pairs this close to a star (voxels) taken exactly")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1000.0));
   cmd->add_flag("--quick", o->quick,
                 "fewer rows (double M = 20, projection N = 4, light basis N = 4 and 6, voxel light N = 4)");
   cmd->add_option("--json", o->json, "also write the results as JSON to this file");
@@ -251,6 +255,7 @@ void add_spectral_bench(CLI::App* bench) {
       base.attenuation = o->attenuation == "law" ? spectral::Attenuation::Law : spectral::Attenuation::Inverse;
       base.R_V = b.R_V;
       base.law = b.law;
+      base.near_voxels = o->near_voxels;
       spectral::SpectralSettings ref_settings = base;
       ref_settings.method = spectral::SpectralMethod::Double;
       ref_settings.wavelengths = o->reference;

@@ -41,6 +41,7 @@ spectral::SpectralSettings spectral_settings(const Scene& scene) {
   s.relative = p.norm == "relative";
   s.fit_depth = p.fit_depth;
   s.max_depth = p.max_depth;
+  s.near_voxels = p.near_voxels;
   s.lo_um = p.range_lo_um;
   s.hi_um = p.range_hi_um;
   return s;

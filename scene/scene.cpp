@@ -148,6 +148,8 @@ std::optional<SceneIssue> spectral_issue(const Scene& s) {
   for (const auto& [key, v] : {std::pair{"spectral.fit_depth", p.fit_depth}, std::pair{"spectral.max_depth", p.max_depth}})
     if (!(std::isfinite(v) && v >= 0 && v <= 1000))
       return SceneIssue{key, "is " + to_text(v) + "; must be in [0, 1000] (V-band optical depth; 0: automatic)"};
+  if (!(std::isfinite(p.near_voxels) && p.near_voxels >= 0 && p.near_voxels <= 1000))
+    return SceneIssue{"spectral.near_voxels", "is " + to_text(p.near_voxels) + "; must be in [0, 1000] (voxels)"};
   if (p.fit_depth > 0 && p.max_depth > 0 && p.fit_depth > p.max_depth)
     return SceneIssue{"spectral.fit_depth", "is " + to_text(p.fit_depth) + ", beyond spectral.max_depth " +
                                                 to_text(p.max_depth)};

@@ -125,6 +125,7 @@ struct SpectralSpec {
   std::string norm = "relative";      // relative (ours) or absolute (the report's)
   double fit_depth = 0;               // V-band optical paths the basis is fitted on; 0: automatic (8)
   double max_depth = 0;               // the coefficient table's range; 0: automatic
+  double near_voxels = 10;            // voxel_light: pairs this close to a star (in voxels) taken exactly
   double range_lo_um = 0, range_hi_um = 0;  // the basis' wavelength range; 0: the bands' span
 };
 

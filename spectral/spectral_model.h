@@ -54,7 +54,7 @@ struct SpectralSettings {
   double lo_um = 0, hi_um = 0;
   // VoxelLight: a voxel whose centre lies within this many voxels of a star takes
   // that star's pair exactly in the march (1/r^2 is not smooth there; docs/spectral.md).
-  double near_voxels = 6;
+  double near_voxels = 10;
 };
 
 struct SpectralStar {

@@ -101,7 +101,7 @@ TEST(SpectralRenderer, VoxelLightMeetsTheGoalWithOneAndSixStars) {
     s.wavelengths = 400;
     const Image ref = render_with(scene, build_spectral_model(f, stars, s));
     s.method = SpectralMethod::VoxelLight;
-    for (double near : {0.0, 4.0, 6.0, 8.0}) {
+    for (double near : {0.0, 4.0, 6.0, 10.0}) {
       s.near_voxels = near;
       const double err = worst_relative(render_with(scene, build_spectral_model(f, stars, s)), ref);
       std::printf("  voxel light, %d star(s), near_voxels %.0f: largest pixel error %.2e\n", n_stars, near, err);
