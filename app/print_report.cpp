@@ -77,7 +77,10 @@ void print_spectral(const RunReport& r) {
     std::printf("  method: analytic integral (exponential-integral recurrence) per voxel, star and filter\n");
   } else {
     std::printf("  method: %s, %d basis element(s) (%s norm) fitted on optical paths 0-%g, table to %g; elements a =",
-                s.method == "projection" ? "projection" : "light-density basis", s.basis, s.norm.c_str(), s.fit_depth,
+                s.method == "projection"    ? "projection"
+                : s.method == "voxel_light" ? "voxel light (per-view pre-pass)"
+                                            : "light-density basis",
+                s.basis, s.norm.c_str(), s.fit_depth,
                 s.max_depth);
     for (double a : s.elements) std::printf(" %.3g", a);
     std::printf("; largest family residual %.2g\n", s.basis_error);

@@ -124,6 +124,7 @@ void add_spectral_bench(CLI::App* bench) {
     std::string backends = "auto", scene, json, attenuation = "inverse";
     std::vector<std::string> overrides;
     int size = 64, width = 256, height = 256, repeats = 3, stars = 1, reference = 400;
+    double near_voxels = spectral::SpectralSettings{}.near_voxels;
     float tau = 4.0f;
     bool quick = false;
     std::vector<std::string> filters{"B", "V", "R"};
@@ -146,7 +147,11 @@ void add_spectral_bench(CLI::App* bench) {
       ->capture_default_str()
       ->check(CLI::Range(2, 4096));
   cmd->add_option("--repeats", o->repeats)->capture_default_str()->check(CLI::PositiveNumber);
-  cmd->add_flag("--quick", o->quick, "fewer rows (double M = 20, projection N = 4, light basis N = 4 and 6)");
+  cmd->add_option("--near-voxels", o->near_voxels, "voxel light: pairs this close to a star (voxels) taken exactly")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1000.0));
+  cmd->add_flag("--quick", o->quick,
+                "fewer rows (double M = 20, projection N = 4, light basis N = 4 and 6, voxel light N = 4)");
   cmd->add_option("--json", o->json, "also write the results as JSON to this file");
   cmd->callback([o, width, height] {
     if (o->attenuation != "inverse" && o->attenuation != "law")
@@ -205,11 +210,13 @@ void add_spectral_bench(CLI::App* bench) {
     std::vector<spectral::SpectralStar> stars;
     for (double t : b.temperature) stars.push_back({t});
     const int S = int(stars.size());
-    const auto inputs = [&](const spectral::SpectralModel& m) {
+    // The first `stars` stars (all by default); the voxel-light buffers reused between frames.
+    const auto inputs = [&](const spectral::SpectralModel& m, spectral::VoxelLightWorkspace* work = nullptr) {
       spectral::SpectralRenderInputs in;
       in.density = &b.grid;
       in.model = &m;
-      for (int k = 0; k < S; ++k) in.lights.push_back({b.positions[k], b.luminosity[k], &bake.tau_v[k]});
+      in.workspace = work;
+      for (int k = 0; k < m.n_stars; ++k) in.lights.push_back({b.positions[k], b.luminosity[k], &bake.tau_v[k]});
       in.albedo = b.albedo;
       in.g = b.g;
       in.camera = b.camera;
@@ -226,13 +233,15 @@ void add_spectral_bench(CLI::App* bench) {
                        ",\n  \"attenuation\": " + json_string(o->attenuation) + ",\n  \"runs\": [";
     for (size_t bi = 0; bi < backends.size(); ++bi) {
       const Backend backend = backends[bi];
-      // Median time of the march and the resolve (the march alone by CUDA events on the GPU).
+      // Median time of the march and the resolve (the march alone by CUDA events on the GPU;
+      // the voxel-light method's pre-pass included, its buffers allocated in the warm-up).
       const auto run = [&](const spectral::SpectralModel& m, Image* out) {
         std::vector<double> times;
+        spectral::VoxelLightWorkspace work;
         for (int r = 0; r < o->repeats + 1; ++r) {
           double s = 0;
           const auto start = std::chrono::steady_clock::now();
-          const Image acc = spectral::render_spectral(inputs(m), backend, &s);
+          const Image acc = spectral::render_spectral(inputs(m, &work), backend, &s);
           const Image img = spectral::resolve_filters(acc, m);
           const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
           if (r > 0 || wall > 5.0) times.push_back(backend == Backend::Cuda ? s : wall);
@@ -246,6 +255,7 @@ void add_spectral_bench(CLI::App* bench) {
       base.attenuation = o->attenuation == "law" ? spectral::Attenuation::Law : spectral::Attenuation::Inverse;
       base.R_V = b.R_V;
       base.law = b.law;
+      base.near_voxels = o->near_voxels;
       spectral::SpectralSettings ref_settings = base;
       ref_settings.method = spectral::SpectralMethod::Double;
       ref_settings.wavelengths = o->reference;
@@ -285,7 +295,8 @@ void add_spectral_bench(CLI::App* bench) {
         r.method = s.method == spectral::SpectralMethod::Double       ? "double"
                    : s.method == spectral::SpectralMethod::Analytic   ? "analytic"
                    : s.method == spectral::SpectralMethod::Projection ? "projection"
-                                                                      : "light_density";
+                   : s.method == spectral::SpectralMethod::LightBasis ? "light_density"
+                                                                      : "voxel_light";
         r.norm = s.relative ? "relative" : "absolute";
         r.basis = m.basis.size();
         r.wavelengths = s.method == spectral::SpectralMethod::Double ? s.wavelengths : 0;
@@ -321,6 +332,50 @@ void add_spectral_bench(CLI::App* bench) {
         s.basis = n;
         row("light basis, N = " + std::to_string(n), s);
       }
+      s.method = spectral::SpectralMethod::VoxelLight;  // the per-view pre-pass: cost flat in the stars
+      for (int n : o->quick ? std::vector<int>{4} : std::vector<int>{3, 4, 5}) {
+        s.basis = n;
+        row("voxel light, N = " + std::to_string(n), s);
+      }
+      // Six spectra at the cost of one: each method with these stars against the same
+      // method with the first star alone, frames alternated in one process (a shared
+      // machine's load then weighs on both alike); medians of `repeats` pairs.
+      std::string ratio_json;
+      if (S > 1) {
+        std::printf("%d stars against the first alone (same method, frames alternated):\n", S);
+        std::printf("%-30s %9s %9s %9s\n", "method", "1 star ms", "all ms", "ratio");
+        std::vector<spectral::SpectralStar> first(stars.begin(), stars.begin() + 1);
+        for (const auto method : {spectral::SpectralMethod::Projection, spectral::SpectralMethod::LightBasis,
+                                  spectral::SpectralMethod::VoxelLight}) {
+          spectral::SpectralSettings rs = base;
+          rs.method = method;
+          rs.basis = 4;
+          if (method == spectral::SpectralMethod::Projection && S * rs.basis > spectral::kMaxAccumulators) continue;
+          const spectral::SpectralModel one = spectral::build_spectral_model(b.filters, first, rs);
+          const spectral::SpectralModel all = spectral::build_spectral_model(b.filters, stars, rs);
+          spectral::VoxelLightWorkspace w1, wa;
+          std::vector<double> t1, ta;
+          for (int r = 0; r < o->repeats + 1; ++r)
+            for (int which = 0; which < 2; ++which) {
+              double sec = 0;
+              const auto start = std::chrono::steady_clock::now();
+              const Image acc = spectral::render_spectral(inputs(which ? all : one, which ? &wa : &w1), backend, &sec);
+              const Image img = spectral::resolve_filters(acc, which ? all : one);
+              const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+              if (r > 0) (which ? ta : t1).push_back(backend == Backend::Cuda ? sec : wall);
+            }
+          std::sort(t1.begin(), t1.end());
+          std::sort(ta.begin(), ta.end());
+          const double ms1 = t1[t1.size() / 2] * 1e3, msa = ta[ta.size() / 2] * 1e3;
+          const std::string name = method == spectral::SpectralMethod::Projection   ? "projection"
+                                   : method == spectral::SpectralMethod::LightBasis ? "light_density"
+                                                                                    : "voxel_light";
+          std::printf("%-30s %9.2f %9.2f %9.3f\n", (name + ", N = 4").c_str(), ms1, msa, msa / ms1);
+          ratio_json += std::string(ratio_json.empty() ? "" : ",") + "\n       {\"method\": " + json_string(name) +
+                        ", \"basis\": 4, \"one_star_ms\": " + to_text(ms1) + ", \"all_stars_ms\": " + to_text(msa) +
+                        ", \"ratio\": " + to_text(msa / ms1) + "}";
+        }
+      }
       json += std::string(bi ? "," : "") + "\n    {\"backend\": " + json_string(backend == Backend::Cuda ? "cuda" : "cpu") +
               ", \"device\": " + json_string(device) + ", \"reference_wavelengths\": " + std::to_string(o->reference) +
               ", \"reference_ms\": " + to_text(ref_time * 1e3) + ",\n     \"rows\": [";
@@ -332,7 +387,7 @@ void add_spectral_bench(CLI::App* bench) {
                 ", \"max_err\": " + to_text(r.max_err) + ", \"p99_err\": " + to_text(r.p99_err) +
                 ", \"mean_err\": " + to_text(r.mean_err) + "}";
       }
-      json += "]}";
+      json += "],\n     \"star_ratios\": [" + ratio_json + "]}";
     }
     json += "\n  ]\n}\n";
     if (!o->json.empty()) {

@@ -93,7 +93,7 @@ struct SpectralFilterReport {
   double fit_error = 0;    // largest |cubic - measured| / peak
 };
 struct SpectralReport {
-  std::string method;             // double, analytic, projection, light_density
+  std::string method;             // double, analytic, projection, light_density, voxel_light
   int basis = 0;                  // elements used (the greedy may stop short)
   int wavelengths = 0;            // double: samples
   std::string attenuation, norm;  // law or inverse; relative or absolute

@@ -22,6 +22,7 @@ spectral::SpectralMethod method_of(const std::string& name) {
   if (name == "double") return spectral::SpectralMethod::Double;
   if (name == "analytic") return spectral::SpectralMethod::Analytic;
   if (name == "light_density") return spectral::SpectralMethod::LightBasis;
+  if (name == "voxel_light") return spectral::SpectralMethod::VoxelLight;
   return spectral::SpectralMethod::Projection;
 }
 
@@ -40,6 +41,7 @@ spectral::SpectralSettings spectral_settings(const Scene& scene) {
   s.relative = p.norm == "relative";
   s.fit_depth = p.fit_depth;
   s.max_depth = p.max_depth;
+  s.near_voxels = p.near_voxels;
   s.lo_um = p.range_lo_um;
   s.hi_um = p.range_hi_um;
   return s;

@@ -129,10 +129,11 @@ std::optional<SceneIssue> filter_issue(const SceneFilter& f) {
 std::optional<SceneIssue> spectral_issue(const Scene& s) {
   const SpectralSpec& p = *s.spectral;
   const bool known_method = p.method == "double" || p.method == "analytic" || p.method == "projection" ||
-                            p.method == "light_density";
+                            p.method == "light_density" || p.method == "voxel_light";
   if (!known_method)
-    return SceneIssue{"spectral.method",
-                      "'" + p.method + "' is not a method (known: double, analytic, projection, light_density)"};
+    return SceneIssue{"spectral.method", "'" + p.method +
+                                             "' is not a method (known: double, analytic, projection, light_density, "
+                                             "voxel_light)"};
   if (p.basis < 1 || p.basis > 16)
     return SceneIssue{"spectral.basis", "is " + std::to_string(p.basis) + "; must be in 1..16 (basis elements)"};
   if (p.wavelengths < 2 || p.wavelengths > 4096)
@@ -147,6 +148,8 @@ std::optional<SceneIssue> spectral_issue(const Scene& s) {
   for (const auto& [key, v] : {std::pair{"spectral.fit_depth", p.fit_depth}, std::pair{"spectral.max_depth", p.max_depth}})
     if (!(std::isfinite(v) && v >= 0 && v <= 1000))
       return SceneIssue{key, "is " + to_text(v) + "; must be in [0, 1000] (V-band optical depth; 0: automatic)"};
+  if (!(std::isfinite(p.near_voxels) && p.near_voxels >= 0 && p.near_voxels <= 1000))
+    return SceneIssue{"spectral.near_voxels", "is " + to_text(p.near_voxels) + "; must be in [0, 1000] (voxels)"};
   if (p.fit_depth > 0 && p.max_depth > 0 && p.fit_depth > p.max_depth)
     return SceneIssue{"spectral.fit_depth", "is " + to_text(p.fit_depth) + ", beyond spectral.max_depth " +
                                                 to_text(p.max_depth)};
@@ -169,7 +172,10 @@ std::optional<SceneIssue> spectral_issue(const Scene& s) {
   if (p.method == "projection" && s.stars.size() * size_t(p.basis) > 64)
     return SceneIssue{"spectral.basis", std::to_string(s.stars.size()) + " stars x " + std::to_string(p.basis) +
                                             " elements exceed the 64 numbers a ray carries; use method = "
-                                            "\"light_density\" (any number of stars)"};
+                                            "\"voxel_light\" (up to 32 stars)"};
+  if (p.method == "voxel_light" && s.stars.size() > 32)
+    return SceneIssue{"stars", std::to_string(s.stars.size()) +
+                                   " stars; the voxel-light method takes at most 32 (use method = \"light_density\")"};
   // The light-density basis is tabulated over star temperature (spectral/spectral_model.cpp).
   if (p.method == "light_density")
     for (size_t i = 0; i < s.stars.size(); ++i)

@@ -118,13 +118,14 @@ struct SceneFilter {
 // power per band. Single scattering in each voxel (the thin-voxel HG phase
 // function), no tables, no light between voxels.
 struct SpectralSpec {
-  std::string method = "projection";  // double, analytic, projection, light_density
+  std::string method = "projection";  // double, analytic, projection, light_density, voxel_light
   int basis = 4;                      // elements of the greedy basis, 1..16
   int wavelengths = 20;               // double: wavelength samples, 2..4096
   std::string attenuation = "law";    // law (dust.law, dust.R_V) or inverse (C_T / lambda, the report's)
   std::string norm = "relative";      // relative (ours) or absolute (the report's)
   double fit_depth = 0;               // V-band optical paths the basis is fitted on; 0: automatic (8)
   double max_depth = 0;               // the coefficient table's range; 0: automatic
+  double near_voxels = 10;            // voxel_light: pairs this close to a star (in voxels) taken exactly
   double range_lo_um = 0, range_hi_um = 0;  // the basis' wavelength range; 0: the bands' span
 };
 

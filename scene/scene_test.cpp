@@ -647,6 +647,8 @@ TEST_F(SceneFile, UserFiltersAndTheSpectralTableAreReadAndChecked) {
   refused("fit_depth", s + "fit_depth = -1\n", {"spectral.fit_depth", "[0, 1000]"});
   refused("fit_past_max", s + "fit_depth = 9\nmax_depth = 5\n", {"spectral.fit_depth", "max_depth"});
   refused("range", s + "range_um = [0.9, 0.3]\n", {"spectral.range_um", "0 < lo < hi"});
+  refused("near_voxels", s + "near_voxels = -1\n", {"spectral.near_voxels", "[0, 1000]"});
+  refused("voxel_method", s + "method = \"voxels\"\n", {"spectral.method", "voxel_light"});
   refused("key", s + "elements = 3\n", {"spectral.elements", "unknown key"});
   refused("temperature", edited("class = \"O5V\"", "temperature_K = 0") + "[spectral]\n",
           {"stars.0.temperature_K", "> 0"});

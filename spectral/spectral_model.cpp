@@ -62,6 +62,11 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
       throw Error("spectral: the light-density basis spans black bodies; star spectrum '" + s.table->name +
                   "' is tabulated (use the projection method)");
   }
+  if (settings.method == SpectralMethod::VoxelLight && stars.size() > size_t(kMaxVoxelLightStars))
+    throw Error("spectral: the voxel-light method takes at most " + std::to_string(kMaxVoxelLightStars) + " stars, got " +
+                std::to_string(stars.size()));
+  if (!(settings.near_voxels >= 0 && std::isfinite(settings.near_voxels)))
+    throw Error("spectral: near_voxels is " + to_text(settings.near_voxels) + "; must be >= 0");
   if (settings.method == SpectralMethod::Analytic && settings.attenuation != Attenuation::Inverse)
     throw Error("spectral: the analytic integral needs the attenuation C_T / lambda (attenuation = \"inverse\")");
   SpectralModel m;
@@ -138,7 +143,8 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
       break;
     }
     case SpectralMethod::Projection:
-    case SpectralMethod::LightBasis: {
+    case SpectralMethod::LightBasis:
+    case SpectralMethod::VoxelLight: {
       const bool light = settings.method == SpectralMethod::LightBasis;
       constexpr int kFamilyDepths = 128;
       const int family_temperatures = light ? 16 : 1;
@@ -175,7 +181,9 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
       const int n = m.basis.size();  // may stop short when the family is exhausted
       m.settings.basis = n;
       m.n_temperature = light ? settings.temperature_nodes : 1;
-      m.n_acc = light ? n : S * n;
+      m.n_acc = light ? n : settings.method == SpectralMethod::VoxelLight ? F : S * n;
+      if (m.n_acc > kMaxAccumulators && settings.method == SpectralMethod::VoxelLight)
+        throw Error("spectral: at most 64 filters");
       if (m.n_acc > kMaxAccumulators)
         throw Error("spectral: " + std::to_string(S) + " stars x " + std::to_string(n) +
                     " basis elements exceed the 64 accumulators of a ray (use the light-density basis)");
@@ -208,10 +216,48 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
   return m;
 }
 
+namespace {
+
+// VoxelLight: Q_fj(star, D) = integral S_f kappa s e^(-kappa D) phi_j on the
+// inner products' grid, at the coefficient table's depths; the resolve is the
+// identity (one accumulator per filter).
+void build_star_tables(SpectralModel& m) {
+  const int F = int(m.filters.size()), n = m.basis.size(), S = int(m.stars.size()), D = m.settings.depth_nodes;
+  if (F > kMaxAccumulators) throw Error("spectral: at most 64 filters");
+  const size_t G = m.grid.lambda.size();
+  // h[(s F + f) n + j][i] = weight S_f kappa s phi_j at node i: Q is then h . e^(-kappa D).
+  std::vector<std::vector<double>> h(size_t(S) * F * n, std::vector<double>(G));
+  for (int s = 0; s < S; ++s)
+    for (int f = 0; f < F; ++f)
+      for (size_t i = 0; i < G; ++i) {
+        const double l = m.grid.lambda[i];
+        const double base = m.grid.weight[i] * m.filters[f](l) * m.kappa_grid[i] * m.stars[s].shape(l);
+        for (int j = 0; j < n; ++j) h[(size_t(s) * F + f) * n + j][i] = base * m.basis.phi[j][i];
+      }
+  m.n_acc = F;
+  m.star_coeff.assign(size_t(S) * D * F * n, 0.0f);
+  std::vector<double> e(G);
+  for (int d = 0; d < D; ++d) {
+    for (size_t i = 0; i < G; ++i) e[i] = std::exp(-m.kappa_grid[i] * d * double(m.depth_step));
+    for (int s = 0; s < S; ++s)
+      for (int fj = 0; fj < F * n; ++fj) {
+        const std::vector<double>& row = h[size_t(s) * F * n + fj];
+        double sum = 0.0;
+        for (size_t i = 0; i < G; ++i) sum += row[i] * e[i];
+        m.star_coeff[(size_t(s) * D + d) * F * n + fj] = float(sum);
+      }
+  }
+  m.resolve.assign(size_t(F) * F, 0.0f);
+  for (int f = 0; f < F; ++f) m.resolve[size_t(f) * F + f] = 1.0f;
+}
+
+}  // namespace
+
 void set_filters(SpectralModel& m, const std::vector<std::pair<std::string, Passband>>& filters) {
   const bool light = m.settings.method == SpectralMethod::LightBasis;
-  if (!light && m.settings.method != SpectralMethod::Projection)
-    throw Error("spectral: filters change on a basis only (the projection or light-density method)");
+  const bool voxel = m.settings.method == SpectralMethod::VoxelLight;
+  if (!light && !voxel && m.settings.method != SpectralMethod::Projection)
+    throw Error("spectral: filters change on a basis only (the projection, light-density or voxel-light method)");
   m.filter_names.clear();
   m.filters.clear();
   m.fits.clear();
@@ -224,6 +270,10 @@ void set_filters(SpectralModel& m, const std::vector<std::pair<std::string, Pass
     m.filter_names.push_back(name);
     m.filters.push_back(fit_passband(band, 2e-3, &r));
     m.fits.push_back(r);
+  }
+  if (voxel) {
+    build_star_tables(m);
+    return;
   }
   const int F = int(filters.size()), n = m.basis.size(), S = int(m.stars.size());
   const size_t G = m.grid.lambda.size();
@@ -259,6 +309,7 @@ SpectralSceneView view_of(const SpectralModel& m) {
   v.n_temperature = m.n_temperature;
   v.depth_step = m.depth_step;
   v.coeff = m.coeff.data();
+  v.star_coeff = m.star_coeff.data();
   return v;
 }
 

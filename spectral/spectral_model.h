@@ -26,7 +26,7 @@ constexpr double kFitDepth = 8.0;
 
 struct SpectralSettings {
   SpectralMethod method = SpectralMethod::Projection;
-  int basis = 4;            // elements of the greedy basis (Projection, LightBasis), 1..16
+  int basis = 4;            // elements of the greedy basis (Projection, LightBasis, VoxelLight), 1..16
   int wavelengths = 20;     // samples of the double integral over the filters' span
   Attenuation attenuation = Attenuation::Inverse;
   double R_V = 5.0;
@@ -52,6 +52,9 @@ struct SpectralSettings {
   // The basis' wavelength range (um); 0: the filters' span. A range fixed
   // ahead lets set_filters change filters with the same basis and tables.
   double lo_um = 0, hi_um = 0;
+  // VoxelLight: a voxel whose centre lies within this many voxels of a star takes
+  // that star's pair exactly in the march (1/r^2 is not smooth there; docs/spectral.md).
+  double near_voxels = 10;
 };
 
 struct SpectralStar {
@@ -80,6 +83,7 @@ struct SpectralModel {
   // Arrays of the view (host copies).
   int n_acc = 0;
   std::vector<float> kappa, q, coeff, temperature_u;
+  std::vector<float> star_coeff;  // VoxelLight: [star][depth][filter][basis] (spectral_march.h)
   std::vector<double> breaks, coefficients;
   int segments = 0;
   float depth_step = 1;
@@ -92,13 +96,15 @@ struct SpectralModel {
 // Errors (ParameterError-free: callers name their keys): no filter, a filter
 // outside the law's range, basis < 1 or > 16, wavelengths < 2, a temperature
 // not positive, Analytic with the Law attenuation, LightBasis with a
-// tabulated star.
+// tabulated star, VoxelLight with more than 32 stars or near_voxels < 0.
 SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Passband>>& filters,
                                    const std::vector<SpectralStar>& stars, const SpectralSettings& settings);
 
 // New filters on the same basis and tables (Projection, LightBasis): only the
 // resolve matrix changes, no march or bake (Barrès' filters changed at run
-// time). Refuses a filter outside the basis' wavelength range.
+// time). VoxelLight: the per-star filter tables are rebuilt (the filters enter
+// its pre-pass, so the march re-runs; no bake). Refuses a filter outside the
+// basis' wavelength range.
 void set_filters(SpectralModel& m, const std::vector<std::pair<std::string, Passband>>& filters);
 
 // The view of a model (pointers into it; stars and grid filled by the renderer).

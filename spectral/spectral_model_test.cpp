@@ -148,6 +148,42 @@ TEST(SpectralModel, RefusesBadSettings) {
   s.attenuation = Attenuation::Law;
   EXPECT_THROW(build_spectral_model(f, {{5770}}, s), Error);
   EXPECT_THROW(build_spectral_model({}, {{5770}}, SpectralSettings{}), Error);
+  SpectralSettings v;
+  v.method = SpectralMethod::VoxelLight;
+  EXPECT_THROW(build_spectral_model(f, std::vector<SpectralStar>(33, SpectralStar{5770}), v), Error);  // one mask bit each
+  EXPECT_NO_THROW(build_spectral_model(f, std::vector<SpectralStar>(32, SpectralStar{5770}), v));
+  v.near_voxels = -1;
+  EXPECT_THROW(build_spectral_model(f, {{5770}}, v), Error);
+}
+
+// The voxel-light tables: Q_fj(star, D) = integral S_f kappa s e^(-kappa D) phi_j, so
+// that sum_j c_j(D_eye) Q_fj(D_star) is the pair's filter integral at D_star + D_eye
+// within the projection's error of e^(-kappa D_eye) (checked against quadrature).
+TEST(SpectralModel, VoxelLightTablesSplitThePath) {
+  SpectralSettings s;
+  s.method = SpectralMethod::VoxelLight;
+  s.attenuation = Attenuation::Law;
+  const std::vector<SpectralStar> stars{{41400}, {3850}};
+  const SpectralModel m = build_spectral_model(filters({"B", "V", "R"}), stars, s);
+  const SpectralSceneView v = view_of(m);
+  const int F = 3, N = v.n_basis;
+  ASSERT_EQ(m.n_acc, F);
+  double worst = 0;
+  for (int k = 0; k < 2; ++k)
+    for (double d_star : {0.0, 0.7, 3.1})
+      for (double d_eye : {0.0, 1.3, 4.2}) {
+        float c[kMaxBasis], q[64 * kMaxBasis];
+        ASSERT_TRUE(depth_coefficients(v, v.coeff, N, float(d_eye), c));
+        ASSERT_TRUE(depth_coefficients(v, v.star_coeff + size_t(k) * v.n_depth * F * N, F * N, float(d_star), q));
+        for (int f = 0; f < F; ++f) {
+          double sum = 0;
+          for (int j = 0; j < N; ++j) sum += c[j] * q[f * N + j];
+          const double ref = reference_integral(m, f, stars[k], d_star + d_eye);
+          worst = std::max(worst, std::fabs(sum - ref) / ref);
+        }
+      }
+  std::printf("  voxel-light tables: largest relative error %.2e against quadrature\n", worst);
+  EXPECT_LT(worst, 1e-2);
 }
 
 // The law's kappa is the CCM curve scaled to 1 over V; C_T / lambda is 1 there too.

@@ -44,7 +44,25 @@ Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds) {
   std::vector<std::string> names;
   for (int k = 0; k < m.n_acc; ++k) names.push_back("acc" + std::to_string(k));
   Image image(in.camera.width, in.camera.height, names);
+  const GridShape& g = in.density->shape;
+  VoxelLightWorkspace local;
+  VoxelLightWorkspace& work = in.workspace ? *in.workspace : local;
+  if (m.settings.method == SpectralMethod::VoxelLight) {
+    work.light.resize(g.count() * 4 * size_t(m.n_acc) * m.basis.size());
+    work.near.resize(g.count());
+    view.near_distance = float(m.settings.near_voxels) * g.voxel;
+  }
   const auto start = std::chrono::steady_clock::now();
+  if (m.settings.method == SpectralMethod::VoxelLight) {  // the per-view pre-pass (timed with the march)
+    constexpr int kRow = 16;  // voxels side by side in the vectorised geometry
+    tbb::parallel_for(tbb::blocked_range<int>(0, g.nz * g.ny), [&](const auto& rows) {
+      for (int r = rows.begin(); r != rows.end(); ++r)
+        for (int x = 0; x < g.nx; x += kRow)
+          voxel_light<kRow>(view, in.camera, x, r % g.ny, r / g.ny, work.light.data(), work.near.data());
+    });
+    view.voxel_light = work.light.data();
+    view.near_stars = work.near.data();
+  }
   dispatch_method(m.settings.method, [&](auto method) {
     tbb::parallel_for(tbb::blocked_range<int>(0, in.camera.height), [&](const auto& rows) {
       float acc[kMaxAccumulators];

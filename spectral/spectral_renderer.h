@@ -19,12 +19,21 @@ struct SpectralLight {
   const std::vector<float>* depth_v = nullptr;  // baked V-band depth per voxel (illumination/optical_depth_bake.h)
 };
 
+// The voxel-light method's per-view buffers (4 F N floats and a star mask per
+// voxel): a caller rendering several frames passes one so that they are
+// allocated (and their pages first touched) once, not per frame.
+struct VoxelLightWorkspace {
+  std::vector<float> light;
+  std::vector<unsigned> near;
+};
+
 struct SpectralRenderInputs {
   const DensityGrid* density = nullptr;
   const SpectralModel* model = nullptr;  // built for these lights, in this order
   std::vector<SpectralLight> lights;
   float albedo = 0.6f, g = 0.6f;
   Camera camera;
+  VoxelLightWorkspace* workspace = nullptr;  // VoxelLight on the CPU: reused buffers (optional)
 };
 
 // The accumulator image (model->n_acc planes); `seconds` the march alone

@@ -28,6 +28,15 @@ __global__ void spectral_kernel(SpectralSceneView scene, Camera camera, float* p
   for (int k = 0; k < scene.n_acc; ++k) pixels[k * plane + size_t(y) * camera.width + x] = acc[k];
 }
 
+// VoxelLight's per-view pre-pass: one thread per voxel (spectral_march.h).
+__global__ void voxel_light_kernel(SpectralSceneView scene, Camera camera, float* light, unsigned* near) {
+  const GridShape& g = scene.density.shape;
+  const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (i >= g.count()) return;
+  const int x = int(i % g.nx), y = int((i / g.nx) % g.ny), z = int(i / (size_t(g.nx) * g.ny));
+  voxel_light<1>(scene, camera, x, y, z, light, near);
+}
+
 template <class T>
 const T* upload(std::vector<std::unique_ptr<DeviceArray<T>>>& keep, const std::vector<T>& host) {
   if (host.empty()) return nullptr;
@@ -59,12 +68,24 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
   view.coeff = upload(floats, m.coeff);
   view.breaks = upload(doubles, m.breaks);
   view.coefficients = upload(doubles, m.coefficients);
+  view.star_coeff = upload(floats, m.star_coeff);
+  const bool voxel = m.settings.method == SpectralMethod::VoxelLight;
+  const size_t cells = in.density->shape.count();
+  DeviceArray<float> light(voxel ? cells * 4 * size_t(m.n_acc) * m.basis.size() : 0);
+  DeviceArray<unsigned> near(voxel ? cells : 0);
+  if (voxel) {
+    view.near_distance = float(m.settings.near_voxels) * in.density->shape.voxel;
+    view.voxel_light = light.get();
+    view.near_stars = near.get();
+  }
   std::vector<std::string> names;
   for (int k = 0; k < m.n_acc; ++k) names.push_back("acc" + std::to_string(k));
   Image image(in.camera.width, in.camera.height, names);
   DeviceArray<float> pixels(image.pixels.size());
   const dim3 block(16, 16), grid((in.camera.width + 15) / 16, (in.camera.height + 15) / 16);
   CudaEventTimer timer;
+  if (voxel)  // the pre-pass, timed with the march
+    voxel_light_kernel<<<unsigned((cells + 255) / 256), 256>>>(view, in.camera, light.get(), near.get());
   dispatch_method(m.settings.method, [&](auto method) {
     spectral_kernel<method()><<<grid, block>>>(view, in.camera, pixels.get());
   });

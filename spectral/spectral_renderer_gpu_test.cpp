@@ -10,8 +10,9 @@
 namespace nebula::spectral {
 namespace {
 
-// The same march_spectral on both backends, every method: accumulators agree
-// to 1e-4 of their peak (float contraction moves voxel crossings by ulps).
+// The same march_spectral on both backends, every method (the voxel-light
+// method's pre-pass too, voxel_light on both): accumulators agree to 1e-4 of
+// their peak (float contraction moves voxel crossings by ulps).
 TEST(SpectralRendererGpu, AgreesWithTheCpu) {
   std::string why;
   if (!gpu_available(&why)) GTEST_SKIP() << why;
@@ -19,7 +20,7 @@ TEST(SpectralRendererGpu, AgreesWithTheCpu) {
   std::vector<std::pair<std::string, Passband>> f;
   for (const char* n : {"B", "V", "R"}) f.push_back({n, load_filter(n)});
   for (SpectralMethod method : {SpectralMethod::Double, SpectralMethod::Analytic, SpectralMethod::Projection,
-                                SpectralMethod::LightBasis}) {
+                                SpectralMethod::LightBasis, SpectralMethod::VoxelLight}) {
     SpectralSettings s;
     s.method = method;
     const SpectralModel m = build_spectral_model(f, {{41400}, {5770}}, s);

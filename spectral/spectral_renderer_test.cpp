@@ -80,6 +80,56 @@ TEST(SpectralRenderer, ProjectionErrorPerBasisSize) {
   EXPECT_GT(absolute, 0.1);
 }
 
+// The voxel-light method (per-view pre-pass, one set of F accumulators for any
+// number of stars) against the double integral (M = 400) with one star and with
+// six of different temperatures: within the issue's 1% per pixel with 4
+// elements. Its error is the projection of e^(-kappa D_eye) alone plus the
+// pre-pass' first-order expansion of 1/r^2 and the phase across a voxel; the
+// nearer a star the larger the second one, hence the exact pairs within
+// near_voxels (printed: the error without them).
+TEST(SpectralRenderer, VoxelLightMeetsTheGoalWithOneAndSixStars) {
+  const std::vector<Vec3> where{{0.1f, 0.2f, -0.1f}, {-0.3f, 0.0f, 0.2f}, {0.2f, -0.3f, 0.1f},
+                                {-0.1f, 0.3f, -0.3f}, {0.3f, 0.1f, 0.3f},  {0.0f, -0.1f, 0.0f}};
+  const std::vector<SpectralStar> temps{{41400}, {31400}, {15700}, {9700}, {5770}, {3850}};
+  const auto f = filters({"B", "V", "R", "sdss_g"});
+  for (int n_stars : {1, 6}) {
+    auto scene = testing::noise_scene(48, 1.0f / 3, std::vector<Vec3>(where.begin(), where.begin() + n_stars), 32, 24);
+    const std::vector<SpectralStar> stars(temps.begin(), temps.begin() + n_stars);
+    SpectralSettings s;
+    s.attenuation = Attenuation::Law;
+    s.method = SpectralMethod::Double;
+    s.wavelengths = 400;
+    const Image ref = render_with(scene, build_spectral_model(f, stars, s));
+    s.method = SpectralMethod::VoxelLight;
+    for (double near : {0.0, 4.0, 6.0, 10.0}) {
+      s.near_voxels = near;
+      const double err = worst_relative(render_with(scene, build_spectral_model(f, stars, s)), ref);
+      std::printf("  voxel light, %d star(s), near_voxels %.0f: largest pixel error %.2e\n", n_stars, near, err);
+      if (near == SpectralSettings{}.near_voxels) {
+        EXPECT_LT(err, 1e-2);
+      }
+    }
+  }
+}
+
+// With one star the voxel-light image is the projection's within their
+// projection errors (each below 1% of the double integral, above).
+TEST(SpectralRenderer, VoxelLightWithOneStarIsTheProjection) {
+  auto scene = testing::noise_scene(48, 1.0f / 3, {{0.1f, 0.2f, -0.1f}}, 32, 24);
+  SpectralSettings s;
+  s.attenuation = Attenuation::Law;
+  const auto f = filters({"B", "V", "R"});
+  const Image projection = render_with(scene, build_spectral_model(f, {{9700}}, s));
+  s.method = SpectralMethod::VoxelLight;
+  const Image voxel = render_with(scene, build_spectral_model(f, {{9700}}, s));
+  const double diff = worst_relative(voxel, projection);
+  std::printf("  voxel light against the projection, one star: largest pixel difference %.2e\n", diff);
+  EXPECT_LT(diff, 2e-2);
+  double peak = 0;
+  for (float v : projection.pixels) peak = std::max(peak, double(v));
+  EXPECT_GT(peak, 0.0);
+}
+
 // A filter change on a fixed basis range: the same accumulators resolved with
 // the new filters equal a fresh render with them.
 TEST(SpectralRenderer, FilterChangeNeedsNoNewMarch) {

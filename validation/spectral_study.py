@@ -16,7 +16,8 @@ Figs. 4.1-4.4 and Tables 4.1-4.4 in our terms, with plots in docs/images.
    per-pixel error of every method against the double integral (Tables 4.1-4.2,
    Fig. 4.5), error and time against basis size.
 3. The same with six stars of different spectra (Tables 4.3-4.4): the
-   light-density basis against the double integral and against one star.
+   light-density basis and the voxel-light method against the double integral
+   and against one star (also alternated in one run: the bench's star_ratios).
 4. Our Fig. 12 scene (scenes/fig12_reference.toml, the scene's CCM89 law).
 Any python3 with numpy and matplotlib; the GPU machine runs it with --backend cuda.
 """
@@ -127,7 +128,7 @@ def size_plot(results, out):
     for label, result in results:
         run = result["runs"][0]
         for method, norm, style in (("projection", "relative", "o-"), ("projection", "absolute", "s--"),
-                                    ("light_density", "relative", "^-")):
+                                    ("light_density", "relative", "^-"), ("voxel_light", "relative", "v-")):
             rows = rows_of(result, method, norm)
             if not rows:
                 continue
@@ -212,6 +213,16 @@ def report(args, summary, one, six, one_law, fig12):
                     r6["method"], r6["basis"], r6["wavelengths"], r6["norm"]):
                 print("| %s N=%d M=%d | %.2f | %.2f | %.2f |" % (r6["method"], r6["basis"], r6["wavelengths"],
                                                               r1["ms"], r6["ms"], r6["ms"] / r1["ms"]))
+    # The same, measured in one process with frames alternated (the six-star run's
+    # `star_ratios`: each method with six stars against the first star alone).
+    ratios = six["runs"][0].get("star_ratios", [])
+    if ratios:
+        print("\n### six stars against the first alone, frames alternated in one run (goal: ratio <= 1.1)\n")
+        print("| method | 1 star ms | 6 stars ms | ratio |")
+        print("| --- | ---: | ---: | ---: |")
+        for r in ratios:
+            print("| %s N=%d | %.2f | %.2f | %.3f |" % (r["method"], r["basis"], r["one_star_ms"], r["all_stars_ms"],
+                                                     r["ratio"]))
     if args.json:
         with open(args.json, "w") as f:
             json.dump(summary, f, indent=1)
