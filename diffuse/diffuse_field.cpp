@@ -34,6 +34,7 @@ void DiffuseField::allocate(size_t bands, bool on_host) {
   response.assign(bands, {});
   response_tau_max.assign(bands, 0.0f);
   device_packed.reset();
+  for (DeviceMirror& m : device_response) m.reset();
 }
 
 const std::vector<float>& DiffuseField::host_packed() const {

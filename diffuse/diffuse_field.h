@@ -177,6 +177,9 @@ struct DiffuseField {
   std::vector<float> response_tau_max;       // [band]
   // The device copy of the harmonics (core/device_mirror.h); changing them resets it.
   mutable DeviceMirror device_packed;
+  // The device copies of the responses, uploaded on a frame's first use
+  // (allocate resets them; a bake sets the responses once).
+  mutable DeviceMirror device_response[kMaxBands];
 
   DiffuseField() = default;
   DiffuseField(const DiffuseField& other);  // shares the device copy: the harmonics are the same

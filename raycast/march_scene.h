@@ -33,7 +33,7 @@ DiffuseView place_diffuse(const DiffuseField& field, Place& place) {
   v.packed = place.place_mirrored(field.device_packed, field.packed_size(),
                                   [&]() -> const std::vector<float>& { return field.host_packed(); });
   for (size_t b = 0; b < field.n_bands() && b < size_t(kMaxBands); ++b)
-    if (field.has_band(b)) v.response[b] = place.place(field.response[b]);
+    if (field.has_band(b)) v.response[b] = place.place(field.response[b], field.device_response[b]);
   return v;
 }
 

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "core/angular_binning.h"
+#include "core/device_mirror.h"
 
 namespace nebula {
 
@@ -42,6 +43,10 @@ struct ScatteringTable {
 
   // Data, each entry with its Monte-Carlo standard error.
   std::vector<float> P;
+  // The CUDA kernels' copy of P, uploaded on first use (core/device_mirror.h;
+  // a copy of the table starts without one). P does not change once a
+  // renderer reads it.
+  mutable DeviceMirror device_P;
   std::vector<float> P_stderr;
   std::vector<double> total;
   std::vector<double> total_stderr;

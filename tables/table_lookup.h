@@ -102,7 +102,7 @@ TableView view_of(const ScatteringTable& table);
 template <class Table, class Place>
 TableView place_table(const Table& table, Place& place) {
   TableView view = view_of(table);
-  view.P = place.place(table.P);
+  view.P = place.place(table.P, table.device_P);  // uploaded once for every frame
   return view;
 }
 
