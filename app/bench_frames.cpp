@@ -147,7 +147,8 @@ void add_viewer_bench(CLI::App* bench) {
                 "re-baked frame; the hand-over to OpenGL is not included");
   add_common(cmd, *o);
   cmd->add_option("--preview-coarsening", *coarsening,
-                 "the preview's grid halved N times, as nebula-view's option (default: 1 on the CPU, 0 on the GPU)");
+                 "the preview's grid halved N times, as nebula-view's option (default: 1 on the CPU, 0 on the GPU)")
+      ->check(CLI::Range(0, 16));
   cmd->callback([o, coarsening] {
     const uint64_t photons = parse_count("--diffuse-photons", o->diffuse_photons, 1, 1e10);
     std::printf("| backend | device | grid | frame | view to frame ms (median of %d) | frames/s | edit to frame ms "

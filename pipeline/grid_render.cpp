@@ -174,7 +174,8 @@ PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o, const Prep
   // What is unchanged is copied (its device copies shared, not uploaded
   // again), leaving `previous` whole: another thread may still render from it.
   PreparedGrid donor;
-  const std::string bake = bake_key(scene, scene_bands(scene), o.backend);
+  const SceneBands bands = scene_bands(scene);
+  const std::string bake = bake_key(scene, bands, o.backend);
   if (bake.empty() || bake != previous.bake_key || previous.bake.tau_v.empty())
     return prepare_grid(scene, o, std::move(donor));
   donor.bake_key = previous.bake_key;
@@ -184,7 +185,7 @@ PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o, const Prep
   for (size_t k = 0; k < previous.bake.device_tau_v.size(); ++k)
     donor.bake.device_tau_v[k].share(previous.bake.device_tau_v[k]);
   const std::string diffuse = scene.multiple_scattering == MultipleScattering::Diffuse
-                                  ? diffuse_key(bake, scene, scene_bands(scene), o)
+                                  ? diffuse_key(bake, scene, bands, o)
                                   : "";
   if (!diffuse.empty() && diffuse == previous.diffuse_key) {
     donor.diffuse = previous.diffuse;  // its device copy shared

@@ -253,7 +253,6 @@ int run(const Args& args) {
 
   ViewerOptions options;
   options.backend = backend;
-  if (args.preview_coarsening < -1) throw Error("--preview-coarsening: must be >= 0");
   options.preview_coarsening = args.preview_coarsening >= 0 ? args.preview_coarsening : (backend == Backend::Cpu ? 1 : 0);
   {
     double photons = 0;
@@ -904,7 +903,8 @@ int main(int argc, char** argv) {
                "view, about 4x faster on the CPU; docs/marcher.md)");
   app.add_option("--preview-coarsening", a.preview_coarsening,
                  "while moving, render from the grid halved N times, baked on its own (default: 1 on the CPU, 0 on "
-                 "the GPU)");
+                 "the GPU)")
+      ->check(CLI::Range(0, 16));
   app.add_option("--preview-photons", a.preview_photons,
                  "diffuse-field photons per band for the viewer's bakes, recorded in the scene (default: 65536 on "
                  "the CPU, the scene's on the GPU; 0: the scene's)");
