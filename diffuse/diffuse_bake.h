@@ -33,6 +33,13 @@ struct DiffuseBakeOptions {
   int roulette_start = 3;          // collisions before Russian roulette plays
   int majorant_block = 4;          // voxels per majorant block edge
   int max_orders = 0;              // 0: every order; k > 0: light scattered at most k times (studies, tests)
+  // CPU: host memory the pass may spend on accumulators of its own per thread
+  // (plain adds); beyond it, or 0, the threads add into one set atomically.
+  size_t private_sums_bytes = size_t(1) << 30;
+  // Albedos sharing a pass: flights after collisions 1..this many deposit
+  // once for all albedos (their weights applied after the pass), later ones
+  // once per albedo. 0 to 16; the same fields either way, up to rounding.
+  int shared_order_buckets = 8;
 };
 
 struct DiffuseBakeStats {
@@ -50,6 +57,21 @@ DiffuseField bake_diffuse(const DensityGrid& density, const std::vector<DiffuseB
                           const std::vector<StarLight>& stars, const DiffuseBakeOptions& options, Backend backend,
                           DiffuseBakeStats* stats = nullptr, Progress* progress = nullptr);
 
+// The fields of several sets of bands that differ only in their albedos (and
+// so their tables), from one photon pass per band: the photons are traced at
+// the band's largest albedo and deposit for every set (diffuse_photon.h,
+// "slots"), at most kMaxAlbedoSlots sets. One field per set, in order, and
+// per set its stats (the passes' time and counters are the shared passes').
+// A set whose albedo is the largest gets the field bake_diffuse gives it, bit
+// for bit; the others an estimate of theirs with their own noise (each
+// set's noise is reported). Throws Error when the sets differ in anything
+// but albedos and tables.
+std::vector<DiffuseField> bake_diffuse_shared(const DensityGrid& density,
+                                              const std::vector<std::vector<DiffuseBand>>& sets,
+                                              const std::vector<StarLight>& stars, const DiffuseBakeOptions& options,
+                                              Backend backend, std::vector<DiffuseBakeStats>* stats = nullptr,
+                                              Progress* progress = nullptr);
+
 // One band's photon pass, as both backends run it: the inputs, and the raw
 // fixed-point sums with the pass's counters.
 struct DiffusePassInputs {
@@ -64,12 +86,27 @@ struct DiffusePassInputs {
   uint64_t seed = 1;
   int roulette_start = 3;
   int max_orders = 0;
+  // Albedos to deposit for (empty: band.albedo alone); band.albedo is the
+  // largest of them, the one the photons are traced at.
+  std::vector<float> slot_albedos;
+  int order_buckets = 0;          // with several slots: orders deposited once for all (DiffuseSlots)
+  size_t private_sums_bytes = 0;  // DiffuseBakeOptions::private_sums_bytes (CPU)
+  int slots() const { return slot_albedos.empty() ? 1 : static_cast<int>(slot_albedos.size()); }
 };
+// The pass's accumulator layout (diffuse_photon.h).
+DiffuseSlots diffuse_slots(const DiffusePassInputs& in, size_t cells, int n_coeffs);
 struct DiffusePassResult {
-  std::vector<unsigned long long> sums;  // [cell * n_coeffs + k], 36.28 fixed point, two's complement
-  std::vector<unsigned long long> odd;   // [cell]: the l = 0 sums of odd photons
+  // CPU: the raw sums, 36.28 fixed point, two's complement, laid out as
+  // DiffuseSlots says (the odd ones with one coefficient); empty from the GPU.
+  std::vector<unsigned long long> sums, odd;
+  // Per slot, [cell * slots + s]: the l = 0 sums of all photons and of the
+  // odd ones, in fixed-point units (for the noise; the CPU's).
+  std::vector<double> l0, odd_l0;
+  // Per slot, the noise's sums (diffuse_cell_noise over the cells; the GPU's).
+  std::vector<double> noise2, signal2;
   PhotonCounters counters;
   double seconds = 0;
+  size_t host_bytes = 0;    // the accumulators (and downloads) the pass held on the host
   size_t device_bytes = 0;
 };
 DiffusePassResult diffuse_pass_cpu(const DiffusePassInputs& in, uint64_t photons, Progress* progress);
@@ -84,15 +121,26 @@ NEBULA_HD double diffuse_cell_volume(const GridShape& grid, int shift, int x, in
 NEBULA_HD float diffuse_coefficient(unsigned long long sum, double unit, double volume) {
   return static_cast<float>(double(static_cast<long long>(sum)) * unit / volume);
 }
+NEBULA_HD float diffuse_coefficient(double sum, double unit, double volume) {
+  return static_cast<float>(sum * unit / volume);
+}
+// A cell's share of the field's relative L2 noise: `all` its l = 0 sum, `odd`
+// that of the odd photons (even - odd has the noise of the whole sum), each
+// over the cell's volume inside the grid.
+NEBULA_HD void diffuse_cell_noise(double all, double odd, double volume, double& noise2, double& signal2) {
+  noise2 += (all - 2 * odd) * (all - 2 * odd) / (volume * volume);
+  signal2 += all * all / (volume * volume);
+}
 
 // Every band's pass on the GPU with the grid uploaded once; the harmonics are
-// made from the sums there and stay there, in field->device_packed (the
-// field has no host copy until host_packed() fetches one). Per pass (the order of
-// `passes`): its l = 0 sums and odd sums (`sums` holds only k = 0) for the
-// noise, counters and time.
+// made from the sums there and stay there, in each slot's field's
+// device_packed (a field has no host copy until host_packed() fetches one;
+// `fields` has one field per slot, all passes having the same number of
+// slots). Per pass (the order of `passes`): l0 and odd_l0 for the noise,
+// counters and time.
 std::vector<DiffusePassResult> diffuse_passes_cuda(const std::vector<DiffusePassInputs>& passes,
                                                    const std::vector<double>& units, uint64_t photons,
-                                                   const GridShape& grid, DiffuseField* field);
+                                                   const GridShape& grid, const std::vector<DiffuseField*>& fields);
 
 // The pass's kernel scene, assembled once for both backends (core/placement.h).
 template <class Place>
@@ -115,6 +163,10 @@ DiffusePhotonScene assemble_photon_scene(const DiffusePassInputs& in, Place& pla
   s.band = in.band_index;
   s.roulette_start = in.roulette_start;
   s.max_orders = in.max_orders;
+  s.slots = in.slots();
+  s.order_buckets = s.slots > 1 ? in.order_buckets : 0;
+  for (int k = 0; k < s.slots && !in.slot_albedos.empty(); ++k)
+    s.slot_scale[k] = in.slot_albedos[size_t(k)] == in.band.albedo ? 1.0f : in.slot_albedos[size_t(k)] / in.band.albedo;
   return s;
 }
 

@@ -4,7 +4,7 @@
 namespace nebula {
 
 std::vector<DiffusePassResult> diffuse_passes_cuda(const std::vector<DiffusePassInputs>&, const std::vector<double>&,
-                                                   uint64_t, const GridShape&, DiffuseField*) {
+                                                   uint64_t, const GridShape&, const std::vector<DiffuseField*>&) {
   no_cuda_backend();
 }
 

@@ -174,6 +174,10 @@ TEST(DiffuseBake, TheSameFieldOnOneThreadOrMany) {
   }
   ASSERT_EQ(many.host_packed().size(), one.host_packed().size());
   for (size_t i = 0; i < one.host_packed().size(); ++i) ASSERT_EQ(many.host_packed()[i], one.host_packed()[i]) << i;
+  // Sums of each thread's own, or one set added to atomically: the same field.
+  o.private_sums_bytes = 0;
+  const DiffuseField atomic = bake_diffuse(grid, {band}, stars, o, Backend::Cpu);
+  EXPECT_EQ(atomic.host_packed(), many.host_packed());
 }
 
 // The field's noise estimate (its two halves) falls as 1 / sqrt(photons).
@@ -223,8 +227,169 @@ TEST(DiffuseBake, RefusesBadOptionsNamingThem) {
   o = {};
   o.photons = 0;
   EXPECT_EQ(parameter(o), "diffuse_photons");
+  o = {};
+  o.shared_order_buckets = 17;
+  EXPECT_EQ(parameter(o), "shared_order_buckets");
   band.table = nullptr;
   EXPECT_THROW(bake_diffuse(grid, {band}, stars, DiffuseBakeOptions{}, Backend::Cpu), Error);
+}
+
+// A sweep's albedos from one pass (bake_diffuse_shared): bands that differ only
+// in their albedo, each band traced at its largest.
+struct SharedCase {
+  DensityGrid grid = cube(12, 0.25f);
+  ScatteringTable table = thin_table(0.6);
+  std::vector<StarLight> stars{{{0.1f, -0.05f, 0.2f}, {3.0f, 2.0f}}};
+  std::vector<DiffuseBand> bands(float albedo_b, float albedo_v) const {
+    std::vector<DiffuseBand> b(2);
+    b[0].name = "B";
+    b[0].extinction_ratio = 1.2f;
+    b[0].albedo = albedo_b;
+    b[1].name = "V";
+    b[1].albedo = albedo_v;
+    for (DiffuseBand& band : b) {
+      band.g = 0.6f;
+      band.table = &table;
+    }
+    return b;
+  }
+};
+
+// The set at the largest albedo is traced exactly as a bake of its own.
+TEST(DiffuseBakeShared, TheLargestAlbedoGetsItsOwnFieldBitForBit) {
+  const SharedCase c;
+  DiffuseBakeOptions o;
+  o.photons = 20000;
+  o.cells = 6;
+  std::vector<DiffuseBakeStats> stats;
+  const std::vector<DiffuseField> shared = bake_diffuse_shared(
+      c.grid, {c.bands(0.3f, 0.5f), c.bands(0.9f, 0.8f), c.bands(0.6f, 0.2f)}, c.stars, o, Backend::Cpu, &stats);
+  ASSERT_EQ(shared.size(), 3u);
+  ASSERT_EQ(stats.size(), 3u);
+  DiffuseBakeStats alone_stats;
+  const DiffuseField alone = bake_diffuse(c.grid, c.bands(0.9f, 0.8f), c.stars, o, Backend::Cpu, &alone_stats);
+  for (size_t b = 0; b < 2; ++b) {
+    EXPECT_EQ(shared[1].band_coeffs(b), alone.band_coeffs(b)) << "band " << b;
+    EXPECT_EQ(stats[1].noise[b], alone_stats.noise[b]);
+    EXPECT_EQ(shared[1].response[b], alone.response[b]);
+  }
+}
+
+// Slot k deposits weight x (a_k / a_max)^n after n collisions. Orders 1 and 2
+// (before the roulette plays) are linear and quadratic in the albedo for the
+// same photons: the field of a smaller albedo is (s F1 + s^2 F2) with s = a_k /
+// a_max, F1 the largest albedo's first order and F2 its second, up to the
+// fixed-point rounding of each deposit. Both ways of depositing are checked:
+// orders kept apart and weighted after the pass (buckets), and weighted
+// deposits per albedo (no buckets, or order 2 beyond them).
+TEST(DiffuseBakeShared, EachOrderIsWeightedByTheAlbedoRatioToItsPower) {
+ for (int buckets : {0, 1, 4}) {
+  SCOPED_TRACE("order buckets " + std::to_string(buckets));
+  const SharedCase c;
+  DiffuseBakeOptions o;
+  o.photons = 20000;
+  o.cells = 6;
+  o.max_orders = 1;
+  const float a_max = 0.9f, a = 0.45f;
+  const DiffuseField f1 = bake_diffuse(c.grid, c.bands(a_max, a_max), c.stars, o, Backend::Cpu);
+  o.max_orders = 2;
+  const DiffuseField f12 = bake_diffuse(c.grid, c.bands(a_max, a_max), c.stars, o, Backend::Cpu);
+  o.shared_order_buckets = buckets;
+  const std::vector<DiffuseField> shared =
+      bake_diffuse_shared(c.grid, {c.bands(a_max, a_max), c.bands(a, a_max)}, c.stars, o, Backend::Cpu);
+  const double s = double(a) / a_max;
+  for (size_t b = 0; b < 2; ++b) {
+    const std::vector<float> one = f1.band_coeffs(b), both = f12.band_coeffs(b), got = shared[1].band_coeffs(b);
+    const double scale = b == 0 ? s : 1.0;  // band V keeps a_max in both sets
+    double err = 0, norm = 0, second = 0;
+    for (size_t i = 0; i < got.size(); ++i) {
+      const double f2 = double(both[i]) - one[i];
+      const double expected = scale * one[i] + scale * scale * f2;
+      err = std::max(err, std::fabs(got[i] - expected));
+      norm = std::max(norm, std::fabs(expected));
+      second = std::max(second, std::fabs(f2));
+    }
+    ASSERT_GT(second, 0.05 * norm) << "the second order must weigh in for the test to mean anything";
+    EXPECT_LT(err, 1e-5 * norm) << "band " << b;
+  }
+  EXPECT_EQ(shared[0].band_coeffs(0), f12.band_coeffs(0)) << "the traced albedo's set is the plain bake";
+ }
+}
+
+// Every order, roulette included: the shared estimate of a smaller albedo's
+// field against bakes of its own, over independent seeds. The statistic is the
+// field's total (l = 0 over all cells) and the tolerance 4 standard errors of
+// the mean difference.
+TEST(DiffuseBakeShared, SmallerAlbedosAgreeWithBakesOfTheirOwn) {
+ for (int buckets : {0, 4}) {
+  SCOPED_TRACE("order buckets " + std::to_string(buckets));
+  const SharedCase c;
+  DiffuseBakeOptions o;
+  o.shared_order_buckets = buckets;
+  o.photons = 20000;
+  o.cells = 6;
+  const int runs = 12;
+  std::vector<double> diff[2];
+  double total[2] = {0, 0};
+  for (int run = 0; run < runs; ++run) {
+    o.seed = 200 + run;
+    const std::vector<DiffuseField> shared =
+        bake_diffuse_shared(c.grid, {c.bands(0.95f, 0.95f), c.bands(0.3f, 0.6f)}, c.stars, o, Backend::Cpu);
+    o.seed = 900 + run;
+    const DiffuseField own = bake_diffuse(c.grid, c.bands(0.3f, 0.6f), c.stars, o, Backend::Cpu);
+    for (size_t b = 0; b < 2; ++b) {
+      const std::vector<float> x = shared[1].band_coeffs(b), y = own.band_coeffs(b);
+      double sx = 0, sy = 0;
+      for (size_t i = 0; i < x.size(); i += size_t(own.n_coeffs())) {
+        sx += x[i];
+        sy += y[i];
+      }
+      diff[b].push_back(sx - sy);
+      total[b] += sy / runs;
+    }
+  }
+  for (size_t b = 0; b < 2; ++b) {
+    double mean = 0, var = 0;
+    for (double d : diff[b]) mean += d / runs;
+    for (double d : diff[b]) var += (d - mean) * (d - mean) / (runs - 1);
+    const double se = std::sqrt(var / runs);
+    std::printf("band %zu: shared - own total %.4g +- %.2g (total %.4g, %+.2f%%)\n", b, mean, se, total[b],
+                100 * mean / total[b]);
+    EXPECT_GT(se, 0.0);
+    EXPECT_LT(se, 0.02 * total[b]) << "too few photons for the test to mean anything";
+    EXPECT_LT(std::fabs(mean), 4 * se) << "band " << b;
+  }
+ }
+}
+
+TEST(DiffuseBakeShared, RefusesSetsThatDifferBeyondTheAlbedo) {
+  const SharedCase c;
+  DiffuseBakeOptions o;
+  o.photons = 1000;
+  std::vector<DiffuseBand> other_g = c.bands(0.5f, 0.5f);
+  other_g[1].g = 0.3f;
+  EXPECT_THROW(bake_diffuse_shared(c.grid, {c.bands(0.5f, 0.5f), other_g}, c.stars, o, Backend::Cpu), Error);
+  std::vector<DiffuseBand> other_ratio = c.bands(0.5f, 0.5f);
+  other_ratio[0].extinction_ratio = 1.3f;
+  EXPECT_THROW(bake_diffuse_shared(c.grid, {c.bands(0.5f, 0.5f), other_ratio}, c.stars, o, Backend::Cpu), Error);
+  const std::vector<std::vector<DiffuseBand>> too_many(kMaxAlbedoSlots + 1, c.bands(0.5f, 0.5f));
+  EXPECT_THROW(bake_diffuse_shared(c.grid, too_many, c.stars, o, Backend::Cpu), Error);
+}
+
+// A set whose band does not scatter gets no field there, as a bake of its own.
+TEST(DiffuseBakeShared, AnAlbedoOfZeroGetsNoField) {
+  const SharedCase c;
+  DiffuseBakeOptions o;
+  o.photons = 2000;
+  o.cells = 6;
+  std::vector<DiffuseBakeStats> stats;
+  const std::vector<DiffuseField> f =
+      bake_diffuse_shared(c.grid, {c.bands(0.0f, 0.7f), c.bands(0.4f, 0.7f)}, c.stars, o, Backend::Cpu, &stats);
+  EXPECT_TRUE(f[0].response[0].empty());
+  EXPECT_EQ(stats[0].noise[0], -1.0);
+  for (float v : f[0].band_coeffs(0)) ASSERT_EQ(v, 0.0f);
+  EXPECT_FALSE(f[1].response[0].empty());
+  EXPECT_EQ(f[0].band_coeffs(1), f[1].band_coeffs(1));  // band V: the same albedo, the same deposits
 }
 
 // Hard cases: a star at a voxel corner and one inside a voxel of tau 1000,

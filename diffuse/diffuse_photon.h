@@ -16,6 +16,14 @@
 //     wanted, before its own dust (which the table also holds) acts on it.
 // Deposits are 36.28 fixed-point integers, so sums do not depend on the order
 // of the additions: the same field for any thread count or launch shape.
+// Several albedos can share one pass (a sweep over the albedo): the photons
+// are traced at the largest, and a_k's field is the sum over n of
+// (a_k / a_max)^n x the deposits of flights after collision n, an unbiased
+// estimate for each a_k. Flights after the first few collisions deposit into
+// one accumulator per order (the albedos' weights applied afterwards: the
+// cost of one albedo), later ones into one per albedo with the weight
+// applied (DiffuseSlots); the albedo that is the traced one gets the plain
+// pass's sums bit for bit.
 #include <cstdint>
 
 #include "core/dda.h"
@@ -32,6 +40,7 @@ namespace nebula {
 constexpr uint32_t kPurposeDiffuse = 0x4446u;  // "DF"
 constexpr int kDiffuseMaxOrders = 10000;  // a photon is stopped (and counted) beyond this
 constexpr float kDiffuseFixedScale = 268435456.0f;  // 2^28: one unit of weight x cell edge
+constexpr int kMaxAlbedoSlots = 16;  // albedos one pass deposits for
 
 // One band's photon pass, by value (host or device pointers).
 struct DiffusePhotonScene {
@@ -48,6 +57,43 @@ struct DiffusePhotonScene {
   uint32_t band = 0;
   int roulette_start = 3;
   int max_orders = 0;   // 0: every order; k > 0: flights after collisions 1..k only (tests, studies)
+  // Albedos deposited for (DiffuseSlots): slot k's scale a_k / albedo <= 1.
+  int slots = 1;
+  int order_buckets = 0;  // orders with an accumulator of their own (0 with one slot)
+  float slot_scale[kMaxAlbedoSlots] = {1.0f};
+};
+
+// Where a shared pass's deposits go. Entry j of a cell (j < n_coeffs; the
+// odd sums are the same layout with n_coeffs = 1):
+//   flights after collision n <= buckets: [((n - 1) x cells + cell) x n_coeffs + j], unweighted;
+//   later flights, weighted by scale_k^n:  [buckets x cells x n_coeffs + (cell x slots + k) x n_coeffs + j].
+// One slot and no buckets: [cell x n_coeffs + j], the plain pass.
+struct DiffuseSlots {
+  size_t cells = 0;
+  int n_coeffs = 1, buckets = 0, slots = 1;
+  double scale[kMaxAlbedoSlots] = {1.0};
+  NEBULA_HD size_t entries() const { return (size_t(buckets) + size_t(slots)) * cells * size_t(n_coeffs); }
+  NEBULA_HD size_t bucket_index(int order, size_t cell, int j) const {
+    return (size_t(order - 1) * cells + cell) * size_t(n_coeffs) + size_t(j);
+  }
+  NEBULA_HD size_t slot_index(int k, size_t cell, int j) const {
+    return size_t(buckets) * cells * size_t(n_coeffs) + (cell * size_t(slots) + size_t(k)) * size_t(n_coeffs) + size_t(j);
+  }
+  // Slot k's sum of entry j in fixed-point units: the tail plus scale^n x
+  // each bucket; an exact integer sum where the scale is 1.
+  NEBULA_HD double sum(const unsigned long long* sums, int k, size_t cell, int j) const {
+    if (scale[k] == 1.0) {
+      unsigned long long total = sums[slot_index(k, cell, j)];
+      for (int n = 1; n <= buckets; ++n) total += sums[bucket_index(n, cell, j)];
+      return double(static_cast<long long>(total));
+    }
+    double total = double(static_cast<long long>(sums[slot_index(k, cell, j)])), power = 1.0;
+    for (int n = 1; n <= buckets; ++n) {
+      power *= scale[k];
+      total += power * double(static_cast<long long>(sums[bucket_index(n, cell, j)]));
+    }
+    return total;
+  }
 };
 
 struct PhotonCounters {
@@ -97,7 +143,9 @@ NEBULA_HD Vec3 point_at_depth(const DensityView& d, float ratio, Vec3 origin, Ve
 // Traces photon `photon` of the band; deposit(index, fixed_value) adds to
 // accumulator `index` = cell * n_coeffs + k. `odd` receives the l = 0 deposits
 // of odd photons again (the field's noise from its two halves).
-template <class Deposit, class DepositOdd>
+// kShared: the scene has several slots (DiffuseSlots); false compiles the
+// plain pass, with nothing of the slots in it.
+template <bool kShared = false, class Deposit, class DepositOdd>
 NEBULA_HD void trace_diffuse_photon(const DiffusePhotonScene& s, uint32_t photon, Deposit&& deposit,
                                     DepositOdd&& deposit_odd, PhotonCounters& c) {
   if (s.n_stars == 0 || !(s.albedo > 0.0f)) return;
@@ -141,8 +189,16 @@ NEBULA_HD void trace_diffuse_photon(const DiffusePhotonScene& s, uint32_t photon
   const float scale = s.ratio / g.voxel;
   const bool odd = (photon & 1u) != 0u;
   float y[kMaxShCoeffs];
+  float slot_factor[kMaxAlbedoSlots];  // slot_scale^order
+  if constexpr (kShared)
+    for (int k = 0; k < s.slots; ++k) slot_factor[k] = 1.0f;
+  const size_t n_cells = s.cells.count();
+  const size_t tail = size_t(s.order_buckets) * n_cells;  // the slots' entries follow the buckets'
+
   for (int order = 1;; ++order) {
     weight *= s.albedo;
+    if constexpr (kShared)
+      for (int k = 0; k < s.slots; ++k) slot_factor[k] *= s.slot_scale[k];
     if (!(weight > 0.0f)) break;
     if (order >= s.roulette_start) {
       const float q = fminf(1.0f, weight);
@@ -175,11 +231,30 @@ NEBULA_HD void trace_diffuse_photon(const DiffusePhotonScene& s, uint32_t photon
       traverse_segment_cells(s.cells, pos + t_start * dir, pos + t_end * dir,
                              [&](int, int, int, size_t cell, float chord) {
                                ++c.crossings;
-                               const float w = weight * chord * inv_edge * kDiffuseFixedScale;
-                               const size_t base = cell * size_t(s.n_coeffs);
-                               for (int j = 0; j < s.n_coeffs; ++j)
-                                 deposit(base + size_t(j), static_cast<unsigned long long>(llrintf(w * y[j])));
-                               if (odd) deposit_odd(cell, static_cast<unsigned long long>(llrintf(w * y[0])));
+                               const float w_all = weight * chord * inv_edge * kDiffuseFixedScale;
+                               if constexpr (!kShared) {
+                                 const size_t base = cell * size_t(s.n_coeffs);
+                                 for (int j = 0; j < s.n_coeffs; ++j)
+                                   deposit(base + size_t(j), static_cast<unsigned long long>(llrintf(w_all * y[j])));
+                                 if (odd) deposit_odd(cell, static_cast<unsigned long long>(llrintf(w_all * y[0])));
+                                 return;
+                               }
+                               if (order <= s.order_buckets) {  // one accumulator for every albedo
+                                 const size_t at = size_t(order - 1) * n_cells + cell;
+                                 for (int j = 0; j < s.n_coeffs; ++j)
+                                   deposit(at * size_t(s.n_coeffs) + size_t(j),
+                                           static_cast<unsigned long long>(llrintf(w_all * y[j])));
+                                 if (odd) deposit_odd(at, static_cast<unsigned long long>(llrintf(w_all * y[0])));
+                                 return;
+                               }
+                               for (int k = 0; k < s.slots; ++k) {
+                                 const float w = w_all * slot_factor[k];
+                                 const size_t slot = cell * size_t(s.slots) + size_t(k);
+                                 const size_t base = (tail + slot) * size_t(s.n_coeffs);
+                                 for (int j = 0; j < s.n_coeffs; ++j)
+                                   deposit(base + size_t(j), static_cast<unsigned long long>(llrintf(w * y[j])));
+                                 if (odd) deposit_odd(tail + slot, static_cast<unsigned long long>(llrintf(w * y[0])));
+                               }
                              });
     }
     if (!collided || (s.max_orders > 0 && order >= s.max_orders)) break;
