@@ -499,29 +499,47 @@ void add_sweep(CLI::App* bench) {
         for (double gv : g.values)
           separate += run(self + " render " + o->scene + " --set dust.albedo=" + to_text(a) + " --set dust.g=" +
                           to_text(gv) + frame + " -o " + work + "/point" + std::to_string(i++) + ".fits" + b);
-      const double sweep = run(self + " sweep " + o->scene + " --grid dust.albedo=" + o->albedos + " --grid dust.g=" +
-                               o->gs + frame + " -o " + work + "/cube.fits" + b);
-      // The cube against the separate images: the same function, point by point.
-      double worst = 0, peak = 0;
-      i = 0;
-      const Image first = read_image(work + "/point0.fits");
+      const std::string sweep_command = self + " sweep " + o->scene + " --grid dust.albedo=" + o->albedos +
+                                        " --grid dust.g=" + o->gs + frame + b;
+      const double sweep = run(sweep_command + " -o " + work + "/cube.fits");
+      const double own = run(sweep_command + " --separate-photons -o " + work + "/cube_own.fits");
       std::vector<Image> points;
       for (size_t k = 0; k < albedo.values.size() * g.values.size(); ++k)
         points.push_back(read_image(work + "/point" + std::to_string(k) + ".fits"));
-      const std::vector<Image> cube = read_fits_cube(work + "/cube.fits");
-      if (cube.size() != points.size()) throw Error("bench sweep: the cube has " + std::to_string(cube.size()) + " points");
-      for (size_t k = 0; k < points.size(); ++k)
-        for (size_t p = 0; p < first.pixels.size(); ++p) {
-          worst = std::max(worst, double(std::fabs(cube[k].pixels[p] - points[k].pixels[p])));
-          peak = std::max(peak, double(points[k].pixels[p]));
+      // A cube against the separate images, point by point: the largest pixel
+      // difference over the peak, and the largest difference of a point's total.
+      auto compare = [&](const std::string& file, double& worst_pixel, double& worst_total) {
+        const std::vector<Image> cube = read_fits_cube(file);
+        if (cube.size() != points.size())
+          throw Error("bench sweep: " + file + " has " + std::to_string(cube.size()) + " points");
+        double worst = 0, peak = 0;
+        worst_total = 0;
+        for (size_t k = 0; k < points.size(); ++k) {
+          double a = 0, b = 0;
+          for (size_t p = 0; p < points[k].pixels.size(); ++p) {
+            worst = std::max(worst, double(std::fabs(cube[k].pixels[p] - points[k].pixels[p])));
+            peak = std::max(peak, double(points[k].pixels[p]));
+            a += cube[k].pixels[p];
+            b += points[k].pixels[p];
+          }
+          if (b > 0) worst_total = std::max(worst_total, std::fabs(a / b - 1));
         }
+        worst_pixel = peak > 0 ? worst / peak : 0.0;
+      };
+      double shared_pixel, shared_total, own_pixel, own_total;
+      compare(work + "/cube.fits", shared_pixel, shared_total);
+      compare(work + "/cube_own.fits", own_pixel, own_total);
       const size_t n = points.size();
       std::printf("\nsweep, %s%s: %s, %zu points (albedo x %zu, g x %zu), %d x %d\n", to_string(backend),
                   backend == Backend::Cuda ? (" (" + gpu_description() + ")").c_str() : "", o->scene.c_str(), n,
                   albedo.values.size(), g.values.size(), o->width, o->height);
-      std::printf("| tables made beforehand s | %zu separate renders s | one sweep s | s per point, separate | s per point, sweep | speed-up | max |cube - separate| / peak |\n"
-                  "|---|---|---|---|---|---|---|\n| %.1f | %.2f | %.2f | %.3f | %.3f | %.2f | %.3g |\n",
-                  n, tables, separate, sweep, separate / n, sweep / n, separate / sweep, peak > 0 ? worst / peak : 0.0);
+      std::printf("| tables made beforehand s | %zu separate renders s | one sweep s | one sweep, --separate-photons s "
+                  "| s per point: separate, sweep | speed-up | speed-up, --separate-photons | sweep against separate: "
+                  "max pixel / peak, max total | --separate-photons: max pixel / peak |\n"
+                  "|---|---|---|---|---|---|---|---|---|\n| %.1f | %.2f | %.2f | %.2f | %.3f, %.3f | **%.2f** | %.2f | "
+                  "%.3g, %.3g | %.3g |\n",
+                  n, tables, separate, sweep, own, separate / n, sweep / n, separate / sweep, separate / own,
+                  shared_pixel, shared_total, own_pixel);
       std::fflush(stdout);
     }
   });

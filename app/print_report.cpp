@@ -46,6 +46,9 @@ void print_multiple_scattering(const RunReport& r) {
                 d.bands, (unsigned long long)d.photons_per_band, d.order, d.cells.nx, d.cells.ny, d.cells.nz,
                 d.voxels_per_cell, d.wall_seconds, d.seconds);
     if (d.reused) std::printf(" [reused: nothing it depends on changed; figures of its bake]");
+    if (d.shared_with > 0)
+      std::printf(" [one photon pass per band for this and %d other albedo set(s) of the sweep; figures of that pass]",
+                  d.shared_with);
   }
   if (d.done) {
     for (size_t b = 0; b < d.noise.size() && b < r.bands.size(); ++b)

@@ -23,7 +23,7 @@ struct Options {
   std::vector<std::string> overrides, grids;
   int width = -1, height = -1, spp = 64;
   uint64_t seed = 1;
-  bool truth = false, force = false, quiet = false;
+  bool truth = false, force = false, quiet = false, separate_photons = false;
 };
 
 double number(const std::string& spec, const std::string& text) {
@@ -100,6 +100,7 @@ void run_sweep_command(const Options& o) {
   so.truth_options.spp = o.spp;
   so.truth_options.seed = o.seed;
   so.force = o.force;
+  so.share_photons = !o.separate_photons;
   double points = 1;
   for (const CubeAxis& a : axes) points *= double(a.values.size());
   if (points > double(kMaxSweepPoints) && !o.force)
@@ -117,12 +118,25 @@ void run_sweep_command(const Options& o) {
     if (bar) bar->finish();
     write_cube(r.images, r.axes, o.out, r.metadata, o.force);
   }, o.scene);
-  size_t bakes = 0, fields = 0, reused_bakes = 0, reused_fields = 0;
+  size_t bakes = 0, fields = 0, reused_bakes = 0, reused_fields = 0, shared_fields = 0;
   for (const RunReport& rep : r.reports) {
     bakes += rep.bake.done;
     reused_bakes += rep.bake.reused;
     fields += rep.diffuse.done;
     reused_fields += rep.diffuse.reused;
+    shared_fields += rep.diffuse.done && !rep.diffuse.reused && rep.diffuse.shared_with > 0;
+  }
+  // Where the points' time went (a shared bake's figures split between its members).
+  double tables = 0, star_bakes = 0, fields_wall = 0, passes = 0, frames = 0, points_total = 0;
+  for (const RunReport& rep : r.reports) {
+    for (const TableReport& t : rep.tables) tables += t.seconds;
+    if (rep.bake.done && !rep.bake.reused) star_bakes += rep.bake.seconds;
+    if (rep.diffuse.done && !rep.diffuse.reused) {
+      fields_wall += rep.diffuse.wall_seconds / (1 + rep.diffuse.shared_with);
+      passes += rep.diffuse.seconds / (1 + rep.diffuse.shared_with);
+    }
+    frames += rep.render_seconds;
+    points_total += rep.total_seconds;
   }
   std::printf("sweep: %zu points (", r.images.size());
   for (size_t k = 0; k < axes.size(); ++k)
@@ -130,8 +144,15 @@ void run_sweep_command(const Options& o) {
   std::printf(") in %.3g s, %.3g s per point; %s\n", r.seconds, r.seconds / double(r.images.size()),
               o.truth ? "the ground truth" : "the fast renderer");
   if (!o.truth)
-    std::printf("  reused: star bakes %zu of %zu, diffuse fields %zu of %zu (the rest computed for their point)\n",
-                reused_bakes, bakes, reused_fields, fields);
+    std::printf("  reused: star bakes %zu of %zu, diffuse fields %zu of %zu; %zu field(s) from photon passes shared "
+                "between albedos (--separate-photons: none); the rest computed for their point\n",
+                reused_bakes, bakes, reused_fields, fields, shared_fields);
+  if (!o.truth)
+    std::printf("  time: %.3g s in the points' renders (tables %.3g, star bakes %.3g, diffuse fields %.3g of which "
+                "photon passes %.3g, frames %.3g, the rest %.3g: scene loads, preparation, copies); %.3g s outside "
+                "them (checking and planning every point, start-up)\n",
+                points_total, tables, star_bakes, fields_wall, passes, frames,
+                points_total - tables - star_bakes - fields_wall - frames, r.seconds - points_total);
   std::printf("wrote %s\n", o.out.c_str());
 }
 
@@ -156,6 +177,9 @@ void add_sweep_command(CLI::App& app) {
   cmd->add_option("--backend", o->backend, "cpu, cuda or auto")->capture_default_str();
   cmd->add_option("--table-photons", o->table_photons, "photons per row for tables generated on first use")
       ->capture_default_str();
+  cmd->add_flag("--separate-photons", o->separate_photons,
+                "every point bakes its diffuse field from photons of its own (each plane then equals a separate "
+                "render bit for bit; slower). Default: points differing only in albedo share one photon pass");
   cmd->add_flag("--force", o->force, "overwrite an existing output; allow more than 100000 points");
   cmd->add_flag("-q,--quiet", o->quiet, "no progress bar");
   cmd->callback([o] { run_sweep_command(*o); });

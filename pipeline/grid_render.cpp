@@ -11,6 +11,7 @@
 #include "multires/volume_pyramid.h"
 #include "pipeline/render_scene.h"
 #include "pipeline/run_setup.h"
+#include "pipeline/shared_diffuse.h"
 
 namespace nebula {
 
@@ -34,18 +35,16 @@ std::string bake_key(const Scene& scene, const SceneBands& bands, Backend backen
   return key;
 }
 
-// What the diffuse field depends on besides the bakes: each band's dust and
-// table, the stars' powers and the field's settings.
-std::string diffuse_key(const std::string& bake, const Scene& scene, const SceneBands& bands, const RenderOptions& o) {
+// What the diffuse field's photons depend on besides the bakes: each band's
+// extinction and g, the stars' powers and the field's settings.
+std::string photon_key(const std::string& bake, const Scene& scene, const SceneBands& bands) {
   if (bake.empty()) return "";
   std::string key = bake + "|mode " + to_string(scene.multiple_scattering);
   const DiffuseSettings& d = scene.diffuse;
   key += "|order " + std::to_string(d.order) + " cells " + std::to_string(d.cells) + " photons " +
-         std::to_string(d.photons) + " seed " + std::to_string(d.seed) + " table photons " +
-         std::to_string(o.table_photons);
+         std::to_string(d.photons) + " seed " + std::to_string(d.seed);
   for (size_t b = 0; b < bands.bands.size(); ++b)
-    key += "|" + bands.bands[b].name + " " + exact(bands.bands[b].extinction_ratio) + " " +
-           exact(bands.bands[b].albedo) + " " + exact(bands.bands[b].g) + " " + scene.dust.table_files[b];
+    key += "|" + bands.bands[b].name + " " + exact(bands.bands[b].extinction_ratio) + " " + exact(bands.bands[b].g);
   for (const StarLight& s : bands.stars) {
     key += "|power";
     for (float p : s.power) key += " " + exact(p);
@@ -53,7 +52,36 @@ std::string diffuse_key(const std::string& bake, const Scene& scene, const Scene
   return key;
 }
 
+// What the field depends on: its photons, and each band's albedo and table.
+std::string diffuse_key(const std::string& bake, const Scene& scene, const SceneBands& bands, const RenderOptions& o) {
+  std::string key = photon_key(bake, scene, bands);
+  if (key.empty()) return "";
+  key += "|table photons " + std::to_string(o.table_photons);
+  for (size_t b = 0; b < bands.bands.size(); ++b)
+    key += "|" + bands.bands[b].name + " albedo " + exact(bands.bands[b].albedo) + " " + scene.dust.table_files[b];
+  return key;
+}
+
+// Whether the scene bakes a field at all (prepare_grid's condition; a band
+// has a table exactly when its albedo is above 0).
+bool bakes_field(const Scene& scene, const SceneBands& bands) {
+  if (scene.axial || scene.multiple_scattering != MultipleScattering::Diffuse || bands.stars.empty()) return false;
+  for (const Band& b : bands.bands)
+    if (b.albedo > 0) return true;
+  return false;
+}
+
 }  // namespace
+
+std::string diffuse_photon_key(const Scene& scene, const RenderOptions& o) {
+  const SceneBands bands = scene_bands(scene);
+  return bakes_field(scene, bands) ? photon_key(bake_key(scene, bands, o.backend), scene, bands) : "";
+}
+
+std::string diffuse_field_key(const Scene& scene, const RenderOptions& o) {
+  const SceneBands bands = scene_bands(scene);
+  return bakes_field(scene, bands) ? diffuse_key(bake_key(scene, bands, o.backend), scene, bands, o) : "";
+}
 
 PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o) {
   PreparedGrid none;

@@ -1,5 +1,6 @@
 #include "pipeline/render_session.h"
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <sstream>
@@ -59,6 +60,84 @@ const Scene& RenderSession::load(const std::vector<std::string>& overrides) {
   return *scene_;
 }
 
+std::unique_ptr<Scene> RenderSession::load_detached(const std::vector<std::string>& overrides) const {
+  std::vector<std::string> all = overrides_;
+  all.insert(all.end(), overrides.begin(), overrides.end());
+  return std::make_unique<Scene>(load_scene_text(text_, name_, base_dir_, all, scene_.get()));
+}
+
+std::vector<RenderSession::PlannedPoint> RenderSession::plan(const std::vector<std::vector<std::string>>& points) {
+  groups_.clear();
+  ready_.clear();
+  std::vector<PlannedPoint> out(points.size());
+  std::map<std::string, int> group_of, field_of;
+  // Every point's scene first (the check before any work), kept without its
+  // grids where it brings a new field; then those fields' tables.
+  std::vector<std::vector<std::unique_ptr<Scene>>> members;
+  for (size_t i = 0; i < points.size(); ++i) {
+    std::unique_ptr<Scene> scene = load_detached(points[i]);
+    const std::string photons = diffuse_photon_key(*scene, options_);
+    if (photons.empty()) continue;
+    const std::string field = diffuse_field_key(*scene, options_);
+    auto g = group_of.emplace(photons, int(groups_.size()));
+    if (g.second) {
+      groups_.emplace_back();
+      members.emplace_back();
+    }
+    auto f = field_of.emplace(field, int(field_of.size()));
+    if (f.second) {
+      scene->density = {};
+      scene->emission.clear();
+      members[size_t(g.first->second)].push_back(std::move(scene));
+    }
+    out[i] = {g.first->second, f.first->second};
+  }
+  for (size_t g = 0; g < groups_.size(); ++g)
+    if (members[g].size() > 1)
+      for (const std::unique_ptr<Scene>& scene : members[g])
+        groups_[g].members.push_back(shared_diffuse_member(*scene, options_));
+  // A group of one field shares nothing.
+  for (PlannedPoint& p : out)
+    if (p.group >= 0 && members[size_t(p.group)].size() < 2) p = {};
+  return out;
+}
+
+bool RenderSession::hand_shared_field(const Scene& scene, PreparedGrid& previous) {
+  if (groups_.empty() && ready_.empty()) return false;
+  const std::string key = diffuse_field_key(scene, options_);
+  if (key.empty() || key == previous.diffuse_key) return false;  // prepare_grid reuses the previous field
+  auto it = ready_.find(key);
+  if (it == ready_.end()) {
+    for (PlanGroup& g : groups_) {
+      const auto at = std::find_if(g.members.begin(), g.members.end(),
+                                   [&](const SharedDiffuseMember& m) { return m.key == key; });
+      if (at == g.members.end()) continue;
+      // This field and the group's next ones not yet baked, as many as one pass takes.
+      std::vector<size_t> chosen{size_t(at - g.members.begin())};
+      for (size_t j = 0; j < g.members.size() && chosen.size() < size_t(kMaxAlbedoSlots); ++j)
+        if (j != chosen.front()) chosen.push_back(j);
+      if (chosen.size() < 2) break;
+      std::vector<SharedDiffuseMember> members;
+      for (size_t j : chosen) members.push_back(g.members[j]);
+      ready_.clear();
+      for (SharedDiffuse& f : bake_shared_diffuse(scene, members, options_)) {
+        const std::string k = f.key;
+        ready_.emplace(k, std::move(f));
+      }
+      std::sort(chosen.begin(), chosen.end());
+      for (auto j = chosen.rbegin(); j != chosen.rend(); ++j) g.members.erase(g.members.begin() + long(*j));
+      break;
+    }
+    it = ready_.find(key);
+    if (it == ready_.end()) return false;
+  }
+  previous.diffuse = std::move(it->second.field);
+  previous.diffuse_key = key;
+  previous.report.diffuse = it->second.report;
+  ready_.erase(it);
+  return true;
+}
+
 RenderOutput RenderSession::render(const std::vector<std::string>& overrides) {
   const auto start = std::chrono::steady_clock::now();
   const Scene& scene = load(overrides);
@@ -69,7 +148,9 @@ RenderOutput RenderSession::render(const std::vector<std::string>& overrides) {
     out = render_scene(scene, options_);
   } else {
     PreparedGrid previous = prepared_ ? std::move(*prepared_) : PreparedGrid{};
+    const bool handed = hand_shared_field(scene, previous);
     auto next = std::make_unique<PreparedGrid>(prepare_grid(scene, options_, std::move(previous)));
+    if (handed) next->report.diffuse.reused = false;  // baked for it, ahead: not reused
     prepared_ = std::move(next);
     retired_.reset();
     out = render_prepared(*prepared_, scene.camera);

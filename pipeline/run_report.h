@@ -47,6 +47,7 @@ struct BakeReport {
 struct DiffuseReport {
   bool done = false;
   bool reused = false;  // taken over from an earlier preparation (its figures are that bake's)
+  int shared_with = 0;  // other albedo sets baked by the same photon passes (a sweep; its figures are theirs)
   int order = 0;
   GridShape cells;             // the field's cells ({along the axis, from it, 1} for an axial map)
   int voxels_per_cell = 1;     // along each axis

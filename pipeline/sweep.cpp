@@ -1,8 +1,11 @@
 #include "pipeline/sweep.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 #include <set>
+#include <tuple>
 
 #include "core/error.h"
 #include "pipeline/run_setup.h"
@@ -96,24 +99,53 @@ SweepResult run_sweep(RenderSession& session, const std::vector<CubeAxis>& axes,
   const auto start = std::chrono::steady_clock::now();
   check_axes(axes, o.force);
   const std::vector<std::vector<std::string>> points = sweep_points(axes);
-  // Every point's scene first: bad keys and values fail before any work.
-  for (const std::vector<std::string>& p : points) session.load(p);
+  // Every point's scene first: bad keys and values fail before any work
+  // (planning loads every point).
+  const bool plan_sharing = !o.truth && o.share_photons;
+  if (!plan_sharing)
+    for (const std::vector<std::string>& p : points) session.load(p);
+  // The order of the work: points sharing photons together, equal fields
+  // next to each other (the session reuses the previous point's field).
+  std::vector<size_t> order(points.size());
+  std::iota(order.begin(), order.end(), size_t(0));
+  // The plan ends with the sweep, however it ends: later renders of the
+  // session bake their own fields.
+  struct PlanEnds {
+    RenderSession& session;
+    ~PlanEnds() { session.plan({}); }
+  } plan_ends{session};
+  if (plan_sharing) {
+    const std::vector<RenderSession::PlannedPoint> plan = session.plan(points);
+    std::vector<size_t> group_first(points.size(), points.size()), field_first(points.size(), points.size());
+    for (size_t i = 0; i < points.size(); ++i) {
+      if (plan[i].group >= 0) group_first[size_t(plan[i].group)] = std::min(group_first[size_t(plan[i].group)], i);
+      if (plan[i].field >= 0) field_first[size_t(plan[i].field)] = std::min(field_first[size_t(plan[i].field)], i);
+    }
+    auto rank = [&](size_t i) {
+      return std::make_tuple(plan[i].group >= 0 ? group_first[size_t(plan[i].group)] : i,
+                             plan[i].field >= 0 ? field_first[size_t(plan[i].field)] : i, i);
+    };
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return rank(a) < rank(b); });
+  }
   SweepResult r;
   r.axes = axes;
-  std::vector<ImageMetadata> metadata;
-  for (size_t i = 0; i < points.size(); ++i) {
+  r.images.resize(points.size());
+  r.reports.resize(points.size());
+  std::vector<ImageMetadata> metadata(points.size());
+  for (size_t done = 0; done < order.size(); ++done) {
+    const size_t i = order[done];
     if (o.truth) {
       TruthRenderOutput t = session.truth(points[i], o.truth_options);
-      r.images.push_back(std::move(t.image));
-      metadata.push_back(std::move(t.metadata));
-      r.reports.push_back(std::move(t.report));
+      r.images[i] = std::move(t.image);
+      metadata[i] = std::move(t.metadata);
+      r.reports[i] = std::move(t.report);
     } else {
       RenderOutput f = session.render(points[i]);
-      r.images.push_back(std::move(f.image));
-      metadata.push_back(std::move(f.metadata));
-      r.reports.push_back(std::move(f.report));
+      r.images[i] = std::move(f.image);
+      metadata[i] = std::move(f.metadata);
+      r.reports[i] = std::move(f.report);
     }
-    if (on_point) on_point(i + 1, points.size());
+    if (on_point) on_point(done + 1, points.size());
   }
   r.metadata = metadata.front();
   r.metadata.entries = common_entries(metadata);

@@ -20,6 +20,10 @@ struct SweepOptions {
   bool truth = false;    // the ground truth instead of the fast renderer
   TruthOptions truth_options;
   bool force = false;    // allow more than kMaxSweepPoints points
+  // Fast sweeps: points whose diffuse fields differ only in the albedos
+  // share one photon pass per band (RenderSession::plan), computed group by
+  // group; false: every point bakes its own, bit for bit a separate render.
+  bool share_photons = true;
 };
 
 struct SweepResult {
@@ -35,6 +39,8 @@ std::vector<std::vector<std::string>> sweep_points(const std::vector<CubeAxis>& 
 
 // Every point's scene is loaded (and so checked: an unknown key, a bad
 // value) before any rendering; errors name the key and the point's value.
+// Points are computed in an order that keeps the points sharing photons
+// together; the result is in grid order.
 // Refuses an empty axis, a repeated key and more than kMaxSweepPoints points
 // unless forced. `on_point` (may be empty) hears each point done (index, count).
 SweepResult run_sweep(RenderSession& session, const std::vector<CubeAxis>& axes, const SweepOptions& options,

@@ -114,6 +114,7 @@ py::dict report_dict(const RunReport& r) {
   d["bake_reused"] = r.bake.reused;
   d["diffuse_seconds"] = r.diffuse.wall_seconds;
   d["diffuse_reused"] = r.diffuse.reused;
+  d["diffuse_shared_with"] = r.diffuse.shared_with;
   d["render_seconds"] = r.render_seconds;
   d["total_seconds"] = r.total_seconds;
   return d;
@@ -189,7 +190,7 @@ class PySession {
                           PyImage{std::move(out.variance), out.variance_metadata, report});
   }
 
-  py::dict sweep(const py::dict& grid, bool truth, int spp, uint64_t seed, bool force) {
+  py::dict sweep(const py::dict& grid, bool truth, int spp, uint64_t seed, bool force, bool share_photons) {
     std::vector<CubeAxis> axes;
     for (auto item : grid) {
       const std::string key = py::str(item.first).cast<std::string>();
@@ -209,6 +210,7 @@ class PySession {
     so.truth_options.spp = spp;
     so.truth_options.seed = seed;
     so.force = force;
+    so.share_photons = share_photons;
     SweepResult r = released([&] { return run_sweep(*session_, axes, so); });
     std::vector<py::ssize_t> shape;
     for (const CubeAxis& a : r.axes) shape.push_back(py::ssize_t(a.values.size()));
@@ -357,8 +359,10 @@ PYBIND11_MODULE(nebula, m) {
       .def("truth", &PySession::truth, py::arg("set") = py::none(), py::arg("spp") = 64, py::arg("seed") = 1,
            py::arg("equiangular") = false, "the ground truth: (mean, variance of the mean)")
       .def("sweep", &PySession::sweep, py::arg("grid"), py::arg("truth") = false, py::arg("spp") = 64,
-           py::arg("seed") = 1, py::arg("force") = false,
-           "a grid {key: values, ...} (first key slowest): dict(data=(n1, ..., bands, rows, columns), axes, ...)");
+           py::arg("seed") = 1, py::arg("force") = false, py::arg("share_photons") = true,
+           "a grid {key: values, ...} (first key slowest): dict(data=(n1, ..., bands, rows, columns), axes, ...); "
+           "share_photons: points differing only in albedo share one photon pass for their diffuse fields "
+           "(False: each its own, equal to a separate render bit for bit)");
 
   m.def("tabulate", &tabulate_py, py::arg("albedo") = 0.6, py::arg("g") = 0.6, py::arg("photons_per_row") = 1e5,
         py::arg("tau_max") = 10.0, py::arg("tau_bins") = 100, py::arg("mu_bins") = 72, py::arg("seed") = 1,

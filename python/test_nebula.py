@@ -84,9 +84,21 @@ def test_sweep_is_each_points_render():
     cube = s.sweep({"dust.albedo": [0.3, 0.9], "dust.g": [0.0, 0.6]})
     assert cube["data"].shape == (2, 2, 3, 20, 24)
     assert [k for k, _ in cube["axes"]] == ["dust.albedo", "dust.g"]
-    ref = session().render({"dust.albedo": 0.9, "dust.g": 0.0})
-    assert np.array_equal(cube["data"][1, 0], ref.data)
+    # The albedos of one g share their photons, traced at the largest albedo:
+    # its planes are the separate renders bit for bit, the others an
+    # estimate of their own field (diffuse/diffuse_bake_test.cpp checks those).
+    assert all(r["diffuse_shared_with"] == 1 for r in cube["reports"])
+    for j, g in enumerate([0.0, 0.6]):
+        ref = session().render({"dust.albedo": 0.9, "dust.g": g})
+        assert np.array_equal(cube["data"][1, j], ref.data)
+        low = session().render({"dust.albedo": 0.3, "dust.g": g})
+        assert not np.array_equal(cube["data"][0, j], low.data)
     assert sum(r["bake_reused"] for r in cube["reports"]) == 3
+    # Photons of its own for every point: every plane a separate render.
+    separate = session().sweep({"dust.albedo": [0.3, 0.9], "dust.g": [0.6]}, share_photons=False)
+    assert all(r["diffuse_shared_with"] == 0 for r in separate["reports"])
+    for i, a in enumerate([0.3, 0.9]):
+        assert np.array_equal(separate["data"][i, 0], session().render({"dust.albedo": a, "dust.g": 0.6}).data)
 
 
 def test_truth_and_compare():
