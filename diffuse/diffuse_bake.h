@@ -93,7 +93,8 @@ struct DiffusePassInputs {
   size_t private_sums_bytes = 0;  // DiffuseBakeOptions::private_sums_bytes (CPU)
   int slots() const { return slot_albedos.empty() ? 1 : static_cast<int>(slot_albedos.size()); }
 };
-// The pass's accumulator layout (diffuse_photon.h).
+// The pass's accumulator layout (diffuse_photon.h): slots, order buckets and
+// each slot's albedo over the traced one (exactly 1 for the traced albedo).
 DiffuseSlots diffuse_slots(const DiffusePassInputs& in, size_t cells, int n_coeffs);
 struct DiffusePassResult {
   // CPU: the raw sums, 36.28 fixed point, two's complement, laid out as
@@ -163,10 +164,10 @@ DiffusePhotonScene assemble_photon_scene(const DiffusePassInputs& in, Place& pla
   s.band = in.band_index;
   s.roulette_start = in.roulette_start;
   s.max_orders = in.max_orders;
-  s.slots = in.slots();
-  s.order_buckets = s.slots > 1 ? in.order_buckets : 0;
-  for (int k = 0; k < s.slots && !in.slot_albedos.empty(); ++k)
-    s.slot_scale[k] = in.slot_albedos[size_t(k)] == in.band.albedo ? 1.0f : in.slot_albedos[size_t(k)] / in.band.albedo;
+  const DiffuseSlots layout = diffuse_slots(in, in.cells.count(), s.n_coeffs);
+  s.slots = layout.slots;
+  s.order_buckets = layout.buckets;
+  for (int k = 0; k < s.slots; ++k) s.slot_scale[k] = static_cast<float>(layout.scale[k]);
   return s;
 }
 

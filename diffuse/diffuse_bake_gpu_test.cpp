@@ -13,20 +13,32 @@
 namespace nebula {
 namespace {
 
-TEST(DiffuseBakeGpu, AgreesWithTheCpuWithinAFractionOfItsNoise) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+// An n^3 cube over [-1, 1]^3 of random tau_v in [0, most).
+DensityGrid random_cube(int n, float most, uint32_t seed) {
   DensityGrid grid;
-  grid.shape.nx = grid.shape.ny = grid.shape.nz = 24;
-  grid.shape.voxel = 2.0f / 24;
+  grid.shape.nx = grid.shape.ny = grid.shape.nz = n;
+  grid.shape.voxel = 2.0f / n;
   grid.shape.origin = {-1, -1, -1};
   grid.tau_v.resize(grid.shape.count());
-  for (size_t c = 0; c < grid.tau_v.size(); ++c) grid.tau_v[c] = 0.3f * philox_uniform4(9, 0, uint32_t(c), 0, 0).u0;
+  for (size_t c = 0; c < grid.tau_v.size(); ++c) grid.tau_v[c] = most * philox_uniform4(seed, 0, uint32_t(c), 0, 0).u0;
+  return grid;
+}
+
+// The optically thin table of Henyey-Greenstein dust (the response needs one).
+ScatteringTable thin_table(double g) {
   ScatteringTable table = ScatteringTable::make_axes(4.0, 9, AngularBinning::UniformTheta, 72);
   for (int i = 0; i < table.n_tau(); ++i)
     for (int k = 0; k < table.n_mu(); ++k)
       table.P[table.index(i, k)] =
-          static_cast<float>(table.tau[i] * hg_bin_mean(0.6, table.mu_edges[k], table.mu_edges[k + 1]));
+          static_cast<float>(table.tau[i] * hg_bin_mean(g, table.mu_edges[k], table.mu_edges[k + 1]));
+  return table;
+}
+
+TEST(DiffuseBakeGpu, AgreesWithTheCpuWithinAFractionOfItsNoise) {
+  std::string why;
+  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  const DensityGrid grid = random_cube(24, 0.3f, 9);
+  const ScatteringTable table = thin_table(0.6);
   std::vector<DiffuseBand> bands(2);
   bands[0].name = "B";
   bands[0].extinction_ratio = 1.2f;
@@ -69,17 +81,8 @@ TEST(DiffuseBakeGpu, AgreesWithTheCpuWithinAFractionOfItsNoise) {
 TEST(DiffuseBakeGpu, SharedAlbedosAgreeWithTheCpu) {
   std::string why;
   if (!gpu_available(&why)) GTEST_SKIP() << why;
-  DensityGrid grid;
-  grid.shape.nx = grid.shape.ny = grid.shape.nz = 20;
-  grid.shape.voxel = 2.0f / 20;
-  grid.shape.origin = {-1, -1, -1};
-  grid.tau_v.resize(grid.shape.count());
-  for (size_t c = 0; c < grid.tau_v.size(); ++c) grid.tau_v[c] = 0.4f * philox_uniform4(5, 0, uint32_t(c), 0, 0).u0;
-  ScatteringTable table = ScatteringTable::make_axes(4.0, 9, AngularBinning::UniformTheta, 72);
-  for (int i = 0; i < table.n_tau(); ++i)
-    for (int k = 0; k < table.n_mu(); ++k)
-      table.P[table.index(i, k)] =
-          static_cast<float>(table.tau[i] * hg_bin_mean(0.3, table.mu_edges[k], table.mu_edges[k + 1]));
+  const DensityGrid grid = random_cube(20, 0.4f, 5);
+  const ScatteringTable table = thin_table(0.3);
   auto bands = [&](float albedo) {
     std::vector<DiffuseBand> b(1);
     b[0].name = "V";

@@ -73,14 +73,10 @@ bool bakes_field(const Scene& scene, const SceneBands& bands) {
 
 }  // namespace
 
-std::string diffuse_photon_key(const Scene& scene, const RenderOptions& o) {
-  const SceneBands bands = scene_bands(scene);
-  return bakes_field(scene, bands) ? photon_key(bake_key(scene, bands, o.backend), scene, bands) : "";
-}
-
-std::string diffuse_field_key(const Scene& scene, const RenderOptions& o) {
-  const SceneBands bands = scene_bands(scene);
-  return bakes_field(scene, bands) ? diffuse_key(bake_key(scene, bands, o.backend), scene, bands, o) : "";
+DiffuseKeys diffuse_keys(const Scene& scene, const SceneBands& bands, const RenderOptions& o) {
+  if (!bakes_field(scene, bands)) return {};
+  const std::string bake = bake_key(scene, bands, o.backend);
+  return {photon_key(bake, scene, bands), diffuse_key(bake, scene, bands, o)};
 }
 
 PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o) {

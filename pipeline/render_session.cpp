@@ -44,9 +44,7 @@ RenderSession RenderSession::from_text(std::string text, std::string name, std::
 }
 
 const Scene& RenderSession::load(const std::vector<std::string>& overrides) {
-  std::vector<std::string> all = overrides_;
-  all.insert(all.end(), overrides.begin(), overrides.end());
-  auto next = std::make_unique<Scene>(load_scene_text(text_, name_, base_dir_, all, scene_.get()));
+  std::unique_ptr<Scene> next = load_detached(overrides);
   const std::vector<SceneInput> inputs = scene_->inputs;
   // The preparation points into the old scene: keep the old one alive until
   // the next render has taken what it can from that preparation.
@@ -73,44 +71,51 @@ std::vector<RenderSession::PlannedPoint> RenderSession::plan(const std::vector<s
   std::map<std::string, int> group_of, field_of;
   // Every point's scene first (the check before any work), kept without its
   // grids where it brings a new field; then those fields' tables.
-  std::vector<std::vector<std::unique_ptr<Scene>>> members;
+  struct Candidate {
+    std::unique_ptr<Scene> scene;
+    SharedDiffuseMember member;
+  };
+  std::vector<std::vector<Candidate>> candidates;
   for (size_t i = 0; i < points.size(); ++i) {
     std::unique_ptr<Scene> scene = load_detached(points[i]);
-    const std::string photons = diffuse_photon_key(*scene, options_);
-    if (photons.empty()) continue;
-    const std::string field = diffuse_field_key(*scene, options_);
-    auto g = group_of.emplace(photons, int(groups_.size()));
+    SceneBands bands = scene_bands(*scene);
+    DiffuseKeys keys = diffuse_keys(*scene, bands, options_);
+    if (keys.photons.empty()) continue;
+    auto g = group_of.emplace(keys.photons, int(groups_.size()));
     if (g.second) {
       groups_.emplace_back();
-      members.emplace_back();
+      candidates.emplace_back();
     }
-    auto f = field_of.emplace(field, int(field_of.size()));
+    auto f = field_of.emplace(keys.field, int(field_of.size()));
     if (f.second) {
       scene->density = {};
       scene->emission.clear();
-      members[size_t(g.first->second)].push_back(std::move(scene));
+      candidates[size_t(g.first->second)].push_back({std::move(scene), {std::move(keys), std::move(bands), {}}});
     }
     out[i] = {g.first->second, f.first->second};
   }
-  for (size_t g = 0; g < groups_.size(); ++g)
-    if (members[g].size() > 1)
-      for (const std::unique_ptr<Scene>& scene : members[g])
-        groups_[g].members.push_back(shared_diffuse_member(*scene, options_));
+  for (size_t g = 0; g < groups_.size(); ++g) {
+    if (candidates[g].size() < 2) continue;
+    for (Candidate& c : candidates[g]) {
+      c.member.tables = resolve_tables(*c.scene, {options_.backend, options_.table_photons, options_.progress});
+      groups_[g].members.push_back(std::move(c.member));
+    }
+  }
   // A group of one field shares nothing.
   for (PlannedPoint& p : out)
-    if (p.group >= 0 && members[size_t(p.group)].size() < 2) p = {};
+    if (p.group >= 0 && candidates[size_t(p.group)].size() < 2) p = {};
   return out;
 }
 
 bool RenderSession::hand_shared_field(const Scene& scene, PreparedGrid& previous) {
   if (groups_.empty() && ready_.empty()) return false;
-  const std::string key = diffuse_field_key(scene, options_);
+  const std::string key = diffuse_keys(scene, scene_bands(scene), options_).field;
   if (key.empty() || key == previous.diffuse_key) return false;  // prepare_grid reuses the previous field
   auto it = ready_.find(key);
   if (it == ready_.end()) {
     for (PlanGroup& g : groups_) {
       const auto at = std::find_if(g.members.begin(), g.members.end(),
-                                   [&](const SharedDiffuseMember& m) { return m.key == key; });
+                                   [&](const SharedDiffuseMember& m) { return m.keys.field == key; });
       if (at == g.members.end()) continue;
       // This field and the group's next ones not yet baked, as many as one pass takes.
       std::vector<size_t> chosen{size_t(at - g.members.begin())};

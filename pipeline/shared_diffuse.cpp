@@ -12,23 +12,13 @@ namespace nebula {
 
 using namespace pipeline_detail;
 
-SharedDiffuseMember shared_diffuse_member(const Scene& scene, const RenderOptions& o) {
-  SharedDiffuseMember m;
-  m.key = diffuse_field_key(scene, o);
-  if (m.key.empty()) throw Error(scene.path + ": its diffuse field cannot be shared (no field, or a grid built in code)");
-  m.bands = scene_bands(scene);
-  m.tables = resolve_tables(scene, {o.backend, o.table_photons, o.progress});
-  return m;
-}
-
 std::vector<SharedDiffuse> bake_shared_diffuse(const Scene& scene, const std::vector<SharedDiffuseMember>& members,
                                                const RenderOptions& o) {
-  const std::string photons = diffuse_photon_key(scene, o);
+  const std::string photons = diffuse_keys(scene, scene_bands(scene), o).photons;
   if (members.empty() || photons.empty()) throw Error("shared diffuse bake: nothing to bake");
   std::vector<std::vector<DiffuseBand>> sets;
   for (const SharedDiffuseMember& m : members) {
-    if (m.key.compare(0, photons.size(), photons) != 0)
-      throw Error("shared diffuse bake: the members differ beyond their albedos");
+    if (m.keys.photons != photons) throw Error("shared diffuse bake: the members differ beyond their albedos");
     sets.push_back(diffuse_bands(m.bands, m.tables));
   }
   const auto t0 = std::chrono::steady_clock::now();
@@ -45,7 +35,7 @@ std::vector<SharedDiffuse> bake_shared_diffuse(const Scene& scene, const std::ve
   const double wall = seconds_since(t0);
   std::vector<SharedDiffuse> out(members.size());
   for (size_t i = 0; i < members.size(); ++i) {
-    out[i].key = members[i].key;
+    out[i].key = members[i].keys.field;
     out[i].report = diffuse_report(sets[i], options, fields[i], 1 << fields[i].shift, stats[i], wall);
     out[i].report.shared_with = static_cast<int>(members.size()) - 1;
     out[i].field = std::move(fields[i]);
