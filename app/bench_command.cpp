@@ -143,7 +143,7 @@ void add_render(CLI::App* bench) {
 
 void add_diffuse(CLI::App* bench) {
   struct Options : Common {
-    int size = 256, width = 1920, height = 1080, degree = DiffuseBakeOptions{}.degree, cells = 64;
+    int size = 256, width = 1920, height = 1080, degree = DiffuseBakeOptions{}.degree, cells = 64, zonal = 0;
     std::string photons = "1048576";
   };
   auto o = std::make_shared<Options>();
@@ -154,6 +154,7 @@ void add_diffuse(CLI::App* bench) {
   add_size(cmd, o->size, 2);
   add_frame(cmd, o->width, o->height);
   cmd->add_option("--order", o->degree, "harmonics' degree")->capture_default_str()->check(CLI::Range(0, kMaxDiffuseDegree));
+  cmd->add_option("--zonal", o->zonal, "zonal degrees of the star's light (0: none)")->capture_default_str()->check(CLI::Range(0, kMaxZonalDegree));
   cmd->add_option("--cells", o->cells, "field cells along the grid's edge (at least)")->capture_default_str()->check(CLI::Range(1, 4096));
   cmd->add_option("--photons", o->photons, "photons per band")->capture_default_str();
   cmd->callback([o] {
@@ -165,7 +166,7 @@ void add_diffuse(CLI::App* bench) {
       // The CPU renders a 1/10 x 1/10 image (same rays per second, minutes less).
       const bool cpu = backend == Backend::Cpu;
       const int w = cpu ? std::max(1, o->width / 10) : o->width, h = cpu ? std::max(1, o->height / 10) : o->height;
-      const DiffuseBench b = bench_diffuse(backend, o->size, w, h, cpu ? 1 : o->repeats, o->degree, o->cells, photons);
+      const DiffuseBench b = bench_diffuse(backend, o->size, w, h, cpu ? 1 : o->repeats, o->degree, o->cells, photons, o->zonal);
       std::printf("| %s | %d^3 | %d^3 | %d | %llu | %.2f | %.2f | %.2f | %.3f (%dx%d) | %.3f | %.1f | %.1f | %.1f | %.2g%% |\n",
                   b.backend.c_str(), b.size, b.cells, b.degree, (unsigned long long)b.photons, 1e3 * b.star_bake_seconds,
                   1e3 * b.photon_seconds, 1e3 * b.bake_wall_seconds, 1e3 * b.frame_without, b.width, b.height,

@@ -41,10 +41,11 @@ void print_multiple_scattering(const RunReport& r) {
                 d.bands, (unsigned long long)d.photons_per_band, d.photon_grid.nx, d.photon_grid.ny, d.photon_grid.nz,
                 d.order, d.cells.nx, d.cells.ny, d.cells.voxel, d.wall_seconds, d.seconds);
   } else if (d.done) {
-    std::printf("  diffuse field (light scattered between voxels): %zu band(s) x %llu photons, harmonics to degree %d "
-                "on %dx%dx%d cells of %d voxel(s); %.3g s (photon passes %.3g s); noise, relative L2 of its l = 0 part:",
-                d.bands, (unsigned long long)d.photons_per_band, d.order, d.cells.nx, d.cells.ny, d.cells.nz,
-                d.voxels_per_cell, d.wall_seconds, d.seconds);
+    std::printf("  diffuse field (light scattered between voxels): %zu band(s) x %llu photons, harmonics to degree %d ",
+                d.bands, (unsigned long long)d.photons_per_band, d.order);
+    if (d.zonal > 0) std::printf("and zonal degrees to %d of %d star(s)' light ", d.zonal, d.zonal_stars);
+    std::printf("on %dx%dx%d cells of %d voxel(s); %.3g s (photon passes %.3g s); noise, relative L2 of its l = 0 part:",
+                d.cells.nx, d.cells.ny, d.cells.nz, d.voxels_per_cell, d.wall_seconds, d.seconds);
     if (d.reused) std::printf(" [reused: nothing it depends on changed; figures of its bake]");
     if (d.shared_with > 0)
       std::printf(" [one photon pass per band for this and %d other albedo set(s) of the sweep; figures of that pass]",

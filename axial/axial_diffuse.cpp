@@ -126,7 +126,11 @@ DiffuseField bake_axial_diffuse(const AxialMap& map, const std::vector<DiffuseBa
   const DensityGrid grid = voxelize_axial_frame(map, voxel);
   AxialDiffuseStats st;
   st.grid = grid.shape;
-  const DiffuseField f3 = bake_diffuse(grid, bands, local, options, backend, &st.bake, progress);
+  // Harmonics only: the ring averages below keep (x, r) cells of harmonics,
+  // not the zonal degrees about each cell's direction from the star.
+  DiffuseBakeOptions harmonics = options;
+  harmonics.zonal = 0;
+  const DiffuseField f3 = bake_diffuse(grid, bands, local, harmonics, backend, &st.bake, progress);
 
   DiffuseField f;
   f.degree = f3.degree;

@@ -27,6 +27,10 @@ void check_options(const DiffuseBakeOptions& o) {
     throw ParameterError("diffuse_photons", "must be 1 to 2^32 - 1 per band, got " + std::to_string(o.photons));
   if (o.roulette_start < 1) throw ParameterError("roulette_start", "must be at least 1");
   if (o.max_orders < 0) throw ParameterError("max_orders", "must be 0 (all) or positive");
+  if (o.zonal != 0 && (o.zonal <= o.degree || o.zonal > kMaxZonalDegree))
+    throw ParameterError("diffuse_zonal", "must be 0 (none) or " + std::to_string(o.degree + 1) + " to " +
+                                              std::to_string(kMaxZonalDegree) + " (above diffuse_order), got " +
+                                              std::to_string(o.zonal));
   if (o.shared_order_buckets < 0 || o.shared_order_buckets > 16)
     throw ParameterError("shared_order_buckets", "must be 0 to 16, got " + std::to_string(o.shared_order_buckets));
 }
@@ -169,9 +173,26 @@ std::vector<DiffuseField> bake_diffuse_shared(const DensityGrid& density,
   check_sets(sets, stars);
   const size_t n_sets = sets.size(), n_bands = sets.front().size();
   std::vector<DiffuseField> fields(n_sets);
+  // The zonal stars: the brightest, by their total power over the bands (the stars keep their order).
+  std::vector<size_t> zonal_order(stars.size());
+  for (size_t i = 0; i < stars.size(); ++i) zonal_order[i] = i;
+  auto total_power = [&](size_t i) {
+    double t = 0;
+    for (float p : stars[i].power) t += std::max(0.0f, p);
+    return t;
+  };
+  if (o.zonal > 0)  // else the photons' stars as given: the same field as without the option
+    std::stable_sort(zonal_order.begin(), zonal_order.end(),
+                     [&](size_t a, size_t b) { return total_power(a) > total_power(b); });
+  const int zonal_stars = o.zonal > 0 ? int(std::min(stars.size(), size_t(kMaxZonalStars))) : 0;
+  std::vector<StarLight> ordered;  // the zonal stars first
+  for (size_t i : zonal_order) ordered.push_back(stars[i]);
   for (DiffuseField& f : fields) {
     f.degree = o.degree;
     f.cells = diffuse_cells(density.shape, o.cells, &f.shift);
+    f.zonal = o.zonal;
+    f.zonal_stars = zonal_stars;
+    for (int k = 0; k < zonal_stars; ++k) f.zonal_star[k] = ordered[size_t(k)].position;
   }
   const DiffuseField& shape = fields.front();
   std::vector<DiffuseBakeStats> st(n_sets);
@@ -195,7 +216,7 @@ std::vector<DiffuseField> bake_diffuse_shared(const DensityGrid& density,
     in.density = &density;
     in.majorant = &majorant;
     double running = 0;
-    for (const StarLight& s : stars) {
+    for (const StarLight& s : ordered) {
       in.stars.push_back(s.position);
       running += std::max(0.0f, s.power[b]);
       in.star_cdf.push_back(static_cast<float>(running / total));
@@ -208,6 +229,8 @@ std::vector<DiffuseField> bake_diffuse_shared(const DensityGrid& density,
     in.band_index = static_cast<uint32_t>(b);
     in.cells = cells;
     in.degree = o.degree;
+    in.zonal = o.zonal;
+    in.zonal_stars = zonal_stars;
     in.seed = o.seed;
     in.roulette_start = o.roulette_start;
     in.max_orders = o.max_orders;
@@ -284,7 +307,7 @@ std::vector<DiffuseField> bake_diffuse_shared(const DensityGrid& density,
       if (known) {
         field.response[b] = *known;
       } else {
-        field.response[b] = delta_m_response(*band.table, o.degree);
+        field.response[b] = delta_m_response(*band.table, o.degree, o.zonal);
         responses.emplace_back(band.table, &field.response[b]);
       }
       field.response_tau_max[b] = static_cast<float>(band.table->tau_max());

@@ -40,6 +40,9 @@ struct DiffuseBakeOptions {
   // once for all albedos (their weights applied after the pass), later ones
   // once per albedo. 0 to 16; the same fields either way, up to rounding.
   int shared_order_buckets = 8;
+  // "diffuse_zonal": degrees degree + 1 .. this of each of the brightest
+  // kMaxZonalStars stars' light, about the direction from the star (0: none).
+  int zonal = 0;
 };
 
 struct DiffuseBakeStats {
@@ -83,6 +86,7 @@ struct DiffusePassInputs {
   uint32_t band_index = 0;
   GridShape cells;
   int degree = 0;
+  int zonal = 0, zonal_stars = 0;  // DiffuseField's: the stars' first zonal_stars have zonal blocks
   uint64_t seed = 1;
   int roulette_start = 3;
   int max_orders = 0;
@@ -156,7 +160,10 @@ DiffusePhotonScene assemble_photon_scene(const DiffusePassInputs& in, Place& pla
   s.g = in.band.g;
   s.cells = in.cells;
   s.degree = in.degree;
-  s.n_coeffs = sh_count(in.degree);
+  s.n_sh = sh_count(in.degree);
+  s.zonal = in.zonal > in.degree ? in.zonal : 0;
+  s.zonal_stars = s.zonal > 0 ? in.zonal_stars : 0;
+  s.n_coeffs = s.n_sh + s.zonal_stars * (s.zonal > 0 ? s.zonal - in.degree : 0);
   s.stars = place.place(in.stars);
   s.star_cdf = place.place(in.star_cdf);
   s.n_stars = static_cast<int>(in.stars.size());

@@ -10,8 +10,10 @@
 namespace nebula {
 
 DiffuseField::DiffuseField(const DiffuseField& other)
-    : cells(other.cells), shift(other.shift), degree(other.degree), response(other.response),
+    : cells(other.cells), shift(other.shift), degree(other.degree), zonal(other.zonal),
+      zonal_stars(other.zonal_stars), response(other.response),
       response_tau_max(other.response_tau_max), packed_(other.packed_) {
+  for (int k = 0; k < kMaxZonalStars; ++k) zonal_star[k] = other.zonal_star[k];
   device_packed.share(other.device_packed);
 }
 
@@ -83,12 +85,18 @@ DiffuseView DiffuseField::view(bool without_harmonics) const {
   v.cells = cells;
   v.shift = shift;
   v.degree = degree;
+  v.coeffs = n_coeffs();
+  v.stride = response_stride();
+  v.own_at = n_zonal() > 0 ? diffuse_response_stride(zonal) : 0;
+  v.zonal = n_zonal() > 0 ? zonal : 0;
+  v.zonal_stars = n_zonal() > 0 ? zonal_stars : 0;
+  for (int k = 0; k < kMaxZonalStars; ++k) v.zonal_star[k] = zonal_star[k];
   v.packed = without_harmonics ? nullptr : host_packed().data();
   for (size_t b = 0; b < response.size() && b < size_t(kMaxBands); ++b) {
     if (response[b].empty()) continue;
     v.has[b] = true;
     v.response[b] = response[b].data();
-    v.rows[b] = static_cast<int>(response[b].size() / size_t(diffuse_response_stride(degree)));
+    v.rows[b] = static_cast<int>(response[b].size() / size_t(v.stride));
     v.rows_per_tau[b] = float(v.rows[b] - 1) / response_tau_max[b];
   }
   return v;
@@ -124,20 +132,29 @@ double lanczos_sigma(int l, int degree) {
   return std::sin(x) / x;
 }
 
-std::vector<float> delta_m_response(const ScatteringTable& table, int degree) {
+std::vector<float> delta_m_response(const ScatteringTable& table, int degree, int zonal) {
   if (degree < 0 || degree > kMaxDiffuseDegree)
     throw ParameterError("diffuse_order", "must be 0 to " + std::to_string(kMaxDiffuseDegree) + ", got " +
                                               std::to_string(degree));
-  const int n = degree + 1;
+  if (zonal > kMaxZonalDegree)
+    throw ParameterError("diffuse_zonal", "must be at most " + std::to_string(kMaxZonalDegree));
+  const bool has_zonal = zonal > degree;
+  const int n = (has_zonal ? zonal : degree) + 1;
   const std::vector<double> p = legendre_moments(table, n);
-  const int stride = diffuse_response_stride(degree);
+  const int stride = has_zonal ? diffuse_zonal_stride(degree, zonal) : diffuse_response_stride(degree);
+  const int own_at = has_zonal ? diffuse_response_stride(zonal) : 0;
   std::vector<float> out(size_t(table.n_tau()) * stride, 0.0f);
+  // sigma_l (p_l - p_{cut+1}) for l <= cut, then the peak, from `at`.
+  auto put = [](const double* row, int cut, float* o) {
+    const double peak = std::max(0.0, row[cut + 1]);
+    for (int l = 0; l <= cut; ++l) o[l] = static_cast<float>((row[l] - peak) * lanczos_sigma(l, cut));
+    o[cut + 1] = static_cast<float>(peak);
+  };
   for (int i = 0; i < table.n_tau(); ++i) {
     const double* row = p.data() + size_t(i) * (n + 1);
-    const double peak = std::max(0.0, row[n]);
     float* o = out.data() + size_t(i) * stride;
-    for (int l = 0; l <= degree; ++l) o[l] = static_cast<float>((row[l] - peak) * lanczos_sigma(l, degree));
-    o[degree + 1] = static_cast<float>(peak);
+    if (has_zonal) put(row, zonal, o);
+    put(row, degree, o + own_at);
   }
   return out;
 }

@@ -49,9 +49,16 @@
 namespace nebula {
 
 constexpr int kMaxDiffuseDegree = 4;  // the marchers keep sum_m per degree, 5 per band, in registers
+constexpr int kMaxZonalStars = 4;     // stars whose light keeps zonal degrees (the brightest)
 
 // A response row: p*_0..p*_degree and the peak, padded to whole vector loads.
 NEBULA_HD constexpr int diffuse_response_stride(int degree) { return (degree + 2 + 3) / 4 * 4; }
+// With zonal degrees a row holds two responses, each padded to whole vector
+// loads: the zonal one (r_0..r_zonal, its peak p_{zonal+1}), then from
+// diffuse_response_stride(zonal) on the harmonics' own (r_0..r_degree, p_{degree+1}).
+NEBULA_HD constexpr int diffuse_zonal_stride(int degree, int zonal) {
+  return diffuse_response_stride(zonal) + diffuse_response_stride(degree);
+}
 
 // Four floats at p (16-byte aligned): one vector load on the device.
 struct Quad {
@@ -73,9 +80,14 @@ struct DiffuseView {
   GridShape cells;     // the field's cells; cell edge = 2^shift voxels
   int shift = 0;
   int degree = 0;      // l_max
-  const float* packed = nullptr;          // [(cell * (degree + 1)^2 + k) * 4 + band]
+  int coeffs = 1;      // per cell: (degree + 1)^2 harmonics, then the zonal blocks
+  int zonal = 0, zonal_stars = 0;  // zonal degrees (0: none) and the stars that have them
+  Vec3 zonal_star[kMaxZonalStars] = {};
+  int stride = 4;      // floats per response row
+  int own_at = 0;      // where the harmonics' own response starts in a row (after the zonal one)
+  const float* packed = nullptr;          // [(cell * coeffs + k) * 4 + band]
   bool has[kMaxBands] = {};               // whether the band has a field (else its slots are 0)
-  const float* response[kMaxBands] = {};  // [row * stride + l]: p*_0..p*_degree, the peak p_{degree+1}, zeros
+  const float* response[kMaxBands] = {};  // [row * stride + own_at + l]: p*_0..p*_degree, the peak p_{degree+1} (and the zonal response before them)
   int rows[kMaxBands] = {};
   float rows_per_tau[kMaxBands] = {};     // (rows - 1) / the table's tau_max
 
@@ -96,7 +108,7 @@ struct DiffuseView {
     for (int b = 0; b < kMaxBands; ++b)
       NEBULA_UNROLL
       for (int l = 0; l <= kDeg; ++l) D[b][l] = 0.0f;
-    const float* c = packed + cell * size_t(n) * 4;
+    const float* c = packed + cell * size_t(coeffs) * 4;
     NEBULA_UNROLL
     for (int k = 0; k < n_max; ++k) {
       if (k >= n) break;
@@ -117,14 +129,14 @@ struct DiffuseView {
     int i = static_cast<int>(u);
     i = i > rows[b] - 2 ? rows[b] - 2 : i;
     const float f = u - float(i);
-    const int stride = diffuse_response_stride(deg);
-    const float* r0 = response[b] + size_t(i) * stride;
+    const int own_stride = diffuse_response_stride(deg);
+    const float* r0 = response[b] + size_t(i) * stride + own_at;
     float s[2] = {0.0f, 0.0f}, p[2] = {0.0f, 0.0f};
     NEBULA_UNROLL
     for (int row = 0; row < 2; ++row)
       NEBULA_UNROLL
       for (int q = 0; q < diffuse_response_stride(kDeg) / 4; ++q) {
-        if (4 * q >= stride) break;
+        if (4 * q >= own_stride) break;
         const Quad r = load_quad(r0 + row * stride + 4 * q);
         NEBULA_UNROLL
         for (int j = 0; j < 4; ++j) {
@@ -137,16 +149,53 @@ struct DiffuseView {
     return s[0] + f * (s[1] - s[0]);
   }
 
-  // The forward peak p_{N+1}(tau_sct) of band b alone (the marcher's
-  // transmittance, any degree).
-  NEBULA_HD float peak(int b, float tau_sct) const {
+  // With zonal degrees: D[l] for l <= zonal (the harmonics' D_l below the
+  // field's degree, the zonal stars' sums above it); the zonal response
+  // sum_l r_l(tau_sct) D_l, each row's sum interpolated.
+  NEBULA_HD float scattered_zonal(int b, float tau_sct, const float* D) const {
     const float u = fminf(fmaxf(tau_sct * rows_per_tau[b], 0.0f), float(rows[b] - 1));
     int i = static_cast<int>(u);
     i = i > rows[b] - 2 ? rows[b] - 2 : i;
     const float f = u - float(i);
-    const int stride = diffuse_response_stride(degree);
-    const float* r = response[b] + size_t(i) * stride + degree + 1;
-    return r[0] + f * (r[stride] - r[0]);
+    const float* r0 = response[b] + size_t(i) * stride;
+    float s0 = 0.0f, s1 = 0.0f;
+    for (int l = 0; l <= zonal; ++l) {
+      s0 += r0[l] * D[l];
+      s1 += r0[stride + l] * D[l];
+    }
+    return s0 + f * (s1 - s0);
+  }
+
+  // How much of a voxel's response at p, seen from to_eye (unit), is the
+  // zonal one (docs/diffuse.md, "Zonal degrees"): all of it where the eye is
+  // on the far side of the voxel from the brightest star (it sees light the
+  // star's light scatters forwards and sideways, which the zonal degrees
+  // resolve), none where the eye looks at the voxel's lit side from beyond
+  // 120 degrees (light scattered back: the harmonics' own response), linear
+  // in the cosine between. 0 without zonal degrees.
+  NEBULA_HD float zonal_weight(Vec3 p, Vec3 to_eye) const {
+    if (zonal == 0) return 0.0f;
+    const Vec3 r = p - zonal_star[0];
+    const float len = length(r);
+    const float mu = len > 0.0f ? dot(r, to_eye) / len : 1.0f;
+    return fminf(1.0f, fmaxf(0.0f, 2.0f * (mu + 0.5f)));  // (mu - cos 120) / (cos 90 - cos 120)
+  }
+
+  // The forward peak p_{N+1}(tau_sct) of band b alone (the marcher's
+  // transmittance, any degree).
+  // With zonal degrees, `zonal_w` (zonal_weight) blends it with the zonal
+  // response's peak p_{zonal+1}.
+  NEBULA_HD float peak(int b, float tau_sct, float zonal_w = 0.0f) const {
+    const float u = fminf(fmaxf(tau_sct * rows_per_tau[b], 0.0f), float(rows[b] - 1));
+    int i = static_cast<int>(u);
+    i = i > rows[b] - 2 ? rows[b] - 2 : i;
+    const float f = u - float(i);
+    const float* r = response[b] + size_t(i) * stride + own_at + degree + 1;
+    const float own = r[0] + f * (r[stride] - r[0]);
+    if (!(zonal_w > 0.0f)) return own;
+    const float* z = response[b] + size_t(i) * stride + zonal + 1;
+    const float theirs = z[0] + f * (z[stride] - z[0]);
+    return own + zonal_w * (theirs - own);
   }
 };
 
@@ -173,6 +222,11 @@ struct DiffuseField {
   GridShape cells;
   int shift = 0;   // a cell spans 2^shift voxels per axis
   int degree = 3;
+  // Zonal degrees degree + 1 .. zonal (0: none) of the light from each of the
+  // first zonal_stars stars, about the direction from the star to the cell.
+  int zonal = 0;
+  int zonal_stars = 0;
+  Vec3 zonal_star[kMaxZonalStars] = {};
   std::vector<std::vector<float>> response;  // [band]: per table row, p*_0..p*_degree, the peak, padding (delta_m_response); empty: no field
   std::vector<float> response_tau_max;       // [band]
   // The device copy of the harmonics (core/device_mirror.h); changing them resets it.
@@ -187,7 +241,9 @@ struct DiffuseField {
   DiffuseField(DiffuseField&&) = default;
   DiffuseField& operator=(DiffuseField&&) = default;
 
-  int n_coeffs() const { return sh_count(degree); }
+  int n_zonal() const { return zonal > degree ? zonal - degree : 0; }
+  int n_coeffs() const { return sh_count(degree) + zonal_stars * n_zonal(); }
+  int response_stride() const { return n_zonal() > 0 ? diffuse_zonal_stride(degree, zonal) : diffuse_response_stride(degree); }
   size_t n_bands() const { return response.size(); }
   bool has_band(size_t b) const { return b < response.size() && !response[b].empty(); }
   size_t packed_size() const { return cells.count() * size_t(n_coeffs()) * 4; }
@@ -219,7 +275,10 @@ std::vector<double> legendre_moments(const ScatteringTable& table, int n);
 // The response a field of this degree uses, per row (diffuse_response_stride
 // values): the forward peak p_{N+1} (0 where it is negative, in thick voxels that scatter
 // mostly backwards) and sigma_l (p_l - peak) for l <= N, then zeros.
-std::vector<float> delta_m_response(const ScatteringTable& table, int degree);
+// With zonal > degree each row holds first the zonal response, sigma_l
+// (p_l - p_{zonal+1}) for l <= zonal with the factors of a cut at `zonal`
+// and that peak, then the harmonics' own as above (diffuse_zonal_stride).
+std::vector<float> delta_m_response(const ScatteringTable& table, int degree, int zonal = 0);
 // Lanczos's sigma factor of degree l in a series cut at `degree`: sinc(l / (degree + 1)), 1 at l = 0.
 double lanczos_sigma(int l, int degree);
 

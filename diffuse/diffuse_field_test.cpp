@@ -63,6 +63,37 @@ TEST(DiffuseResponse, DeltaMSplitsOffTheForwardPeak) {
   EXPECT_THROW(delta_m_response(t, kMaxDiffuseDegree + 1), ParameterError);
 }
 
+// With zonal degrees a row holds two delta-M responses, each padded to whole
+// vector loads: the zonal one cut at the zonal degree (its peak p_{K+1}),
+// then the harmonics' own, exactly the row a field without zonal degrees has.
+TEST(DiffuseResponse, ZonalRowsHoldTheZonalResponseThenTheHarmonicsOwn) {
+  const ScatteringTable t = thin_table(0.9, 720);
+  const int degree = 3, zonal = 16;
+  const std::vector<float> r = delta_m_response(t, degree, zonal);
+  const std::vector<float> own = delta_m_response(t, degree);
+  const std::vector<double> p = legendre_moments(t, zonal + 1);
+  const int stride = diffuse_zonal_stride(degree, zonal), own_at = diffuse_response_stride(zonal);
+  ASSERT_EQ(stride % 4, 0);
+  ASSERT_EQ(own_at % 4, 0);
+  ASSERT_GE(own_at, zonal + 2);
+  ASSERT_EQ(r.size(), size_t(t.n_tau()) * stride);
+  const int own_stride = diffuse_response_stride(degree);
+  for (int i = 0; i < t.n_tau(); ++i) {
+    const float* row = r.data() + size_t(i) * stride;
+    const double* m = p.data() + size_t(i) * (zonal + 2);
+    const double peak = m[zonal + 1];
+    EXPECT_NEAR(row[zonal + 1], peak, 1e-6 * (1 + peak));
+    EXPECT_NEAR(row[zonal + 1], t.tau[i] * std::pow(0.9, zonal + 1), 2e-3 * t.tau[i]);
+    for (int l = 0; l <= zonal; ++l)
+      EXPECT_NEAR(row[l], (m[l] - peak) * lanczos_sigma(l, zonal), 1e-6 * (1 + t.tau[i])) << "row " << i << " l " << l;
+    for (int j = zonal + 2; j < own_at; ++j) EXPECT_EQ(row[j], 0.0f) << "padding";
+    for (int j = 0; j < own_stride; ++j)
+      EXPECT_EQ(row[own_at + j], own[size_t(i) * own_stride + j]) << "the harmonics' own response, row " << i;
+  }
+  EXPECT_EQ(delta_m_response(t, degree, 0), own) << "no zonal degrees: the rows as before";
+  EXPECT_THROW(delta_m_response(t, degree, kMaxZonalDegree + 1), ParameterError);
+}
+
 template <int kDeg>
 void check_truncated_series(const ScatteringTable& t) {
   const int degree = kDeg;

@@ -49,7 +49,12 @@ struct DiffusePhotonScene {
   float albedo = 0, g = 0;
   GridShape cells;       // the field's cells
   int degree = 0;
-  int n_coeffs = 1;
+  int n_coeffs = 1;      // per cell: the harmonics, then each zonal star's block
+  int n_sh = 1;          // the harmonics' share, (degree + 1)^2
+  // Zonal degrees degree + 1 .. zonal about the direction from star k < zonal_stars
+  // to the cell's centre (0: none): block k at n_sh + k x (zonal - degree).
+  int zonal = 0;
+  int zonal_stars = 0;
   const Vec3* stars = nullptr;     // positions
   const float* star_cdf = nullptr; // cumulative band power fractions, last = 1
   int n_stars = 0;
@@ -228,31 +233,47 @@ NEBULA_HD void trace_diffuse_photon(const DiffusePhotonScene& s, uint32_t photon
     if (t_end > t_start) {
       sh_basis(s.degree, dir, y);
       const float inv_edge = 1.0f / s.cells.voxel;
-      traverse_segment_cells(s.cells, pos + t_start * dir, pos + t_end * dir,
+      const int n_zonal = (s.zonal > s.degree && k < s.zonal_stars) ? s.zonal - s.degree : 0;
+      const int zonal_at = s.n_sh + k * (s.zonal - s.degree);
+      const Vec3 star = origin;
+      const Vec3 seg_start = pos + t_start * dir;
+      float along = 0.0f;  // the chord's start, from seg_start
+      traverse_segment_cells(s.cells, seg_start, pos + t_end * dir,
                              [&](int, int, int, size_t cell, float chord) {
                                ++c.crossings;
                                const float w_all = weight * chord * inv_edge * kDiffuseFixedScale;
+                               float z[kMaxZonalDegree];
+                               const float mid = along + 0.5f * chord;
+                               along += chord;
+                               if (n_zonal > 0) {
+                                 // About the direction from the star to the chord's middle.
+                                 const Vec3 r = seg_start + mid * dir - star;
+                                 const float len = length(r);
+                                 const float mu = len > 0.0f ? dot(dir, r) / len : dir.z;
+                                 zonal_basis(s.degree + 1, s.zonal, mu, z);
+                               }
+                               // Entry 0 of the cell's block at `base`, weight w.
+                               auto put = [&](size_t base, float w) {
+                                 for (int j = 0; j < s.n_sh; ++j)
+                                   deposit(base + size_t(j), static_cast<unsigned long long>(llrintf(w * y[j])));
+                                 for (int j = 0; j < n_zonal; ++j)
+                                   deposit(base + size_t(zonal_at + j), static_cast<unsigned long long>(llrintf(w * z[j])));
+                               };
                                if constexpr (!kShared) {
-                                 const size_t base = cell * size_t(s.n_coeffs);
-                                 for (int j = 0; j < s.n_coeffs; ++j)
-                                   deposit(base + size_t(j), static_cast<unsigned long long>(llrintf(w_all * y[j])));
+                                 put(cell * size_t(s.n_coeffs), w_all);
                                  if (odd) deposit_odd(cell, static_cast<unsigned long long>(llrintf(w_all * y[0])));
                                  return;
                                }
                                if (order <= s.order_buckets) {  // one accumulator for every albedo
                                  const size_t at = size_t(order - 1) * n_cells + cell;
-                                 for (int j = 0; j < s.n_coeffs; ++j)
-                                   deposit(at * size_t(s.n_coeffs) + size_t(j),
-                                           static_cast<unsigned long long>(llrintf(w_all * y[j])));
+                                 put(at * size_t(s.n_coeffs), w_all);
                                  if (odd) deposit_odd(at, static_cast<unsigned long long>(llrintf(w_all * y[0])));
                                  return;
                                }
                                for (int k = 0; k < s.slots; ++k) {
                                  const float w = w_all * slot_factor[k];
                                  const size_t slot = cell * size_t(s.slots) + size_t(k);
-                                 const size_t base = (tail + slot) * size_t(s.n_coeffs);
-                                 for (int j = 0; j < s.n_coeffs; ++j)
-                                   deposit(base + size_t(j), static_cast<unsigned long long>(llrintf(w * y[j])));
+                                 put((tail + slot) * size_t(s.n_coeffs), w);
                                  if (odd) deposit_odd(tail + slot, static_cast<unsigned long long>(llrintf(w * y[0])));
                                }
                              });

@@ -79,6 +79,23 @@ NEBULA_HD void sh_rotate_z(int degree, float cos_phi, float sin_phi, const float
   for (int l = 1; l <= degree; ++l) out[l * l + l] = in[l * l + l];
 }
 
+// Zonal harmonics about an axis a: Y_l0(d) = sqrt((2l + 1) / (4 pi)) P_l(a . d),
+// for l = first..last into y[0..last - first] (mu = a . d). The diffuse field
+// keeps the high degrees of the light streaming away from a star this way,
+// about the direction from the star (diffuse_field.h, "zonal").
+constexpr int kMaxZonalDegree = 32;
+NEBULA_HD void zonal_basis(int first, int last, float mu, float* y) {
+  float p_prev = 1.0f, p = mu;  // P_0, P_1
+  if (first == 0) y[0] = 0.28209479177387814f;
+  if (first <= 1 && last >= 1) y[1 - first] = 0.4886025119029199f * mu;
+  for (int l = 1; l < last; ++l) {
+    const float next = ((2.0f * l + 1.0f) * mu * p - float(l) * p_prev) / float(l + 1);
+    p_prev = p;
+    p = next;
+    if (l + 1 >= first) y[l + 1 - first] = sqrtf((2.0f * (l + 1) + 1.0f) * 0.07957747154594767f) * p;
+  }
+}
+
 // The degree l of harmonic k.
 NEBULA_HD int sh_degree_of(int k) { return k < 1 ? 0 : (k < 4 ? 1 : (k < 9 ? 2 : (k < 16 ? 3 : 4))); }
 

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -50,6 +51,32 @@ TEST(SphericalHarmonics, AddUpToLegendrePolynomials) {
       EXPECT_NEAR(sum, (2 * l + 1) / (4 * kPiD) * p[l], 2e-6) << "l = " << l;
     }
   }
+}
+
+// Zonal harmonics about z are the m = 0 harmonics of sh_basis, and about any
+// axis they stay orthonormal up to kMaxZonalDegree (Gauss-Legendre in mu,
+// exact for the products' degree).
+TEST(SphericalHarmonics, ZonalBasisIsTheAxialHarmonicsToItsLastDegree) {
+  float y[kMaxShCoeffs], z[kMaxZonalDegree + 1];
+  for (float mu : {-1.0f, -0.4f, 0.0f, 0.3f, 0.95f, 1.0f}) {
+    const float s = std::sqrt(std::max(0.0f, 1 - mu * mu));
+    sh_basis(kMaxShDegree, Vec3{0.6f * s, 0.8f * s, mu}, y);
+    zonal_basis(0, kMaxShDegree, mu, z);
+    for (int l = 0; l <= kMaxShDegree; ++l) EXPECT_NEAR(z[l], y[l * l + l], 2e-6) << "mu " << mu << " l " << l;
+    float tail[kMaxZonalDegree];
+    zonal_basis(3, kMaxZonalDegree, mu, tail);  // a later first degree: the same values, shifted
+    for (int l = 3; l <= kMaxShDegree; ++l) EXPECT_EQ(tail[l - 3], z[l]);
+  }
+  std::vector<double> mu, w;
+  testing::gauss_legendre(40, -1, 1, mu, w);
+  double gram[kMaxZonalDegree + 1][kMaxZonalDegree + 1] = {};
+  for (size_t i = 0; i < mu.size(); ++i) {
+    zonal_basis(0, kMaxZonalDegree, float(mu[i]), z);
+    for (int a = 0; a <= kMaxZonalDegree; ++a)
+      for (int b = 0; b <= kMaxZonalDegree; ++b) gram[a][b] += 2 * kPiD * w[i] * z[a] * z[b];
+  }
+  for (int a = 0; a <= kMaxZonalDegree; ++a)
+    for (int b = 0; b <= kMaxZonalDegree; ++b) EXPECT_NEAR(gram[a][b], a == b ? 1.0 : 0.0, 2e-5) << a << ", " << b;
 }
 
 TEST(SphericalHarmonics, LegendreMatchesItsClosedForms) {

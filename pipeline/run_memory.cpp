@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <string>
 
 #include "core/error.h"
@@ -46,7 +47,11 @@ RunMemory estimate_run_memory(const Scene& scene, RunKind kind) {
       if (scene.multiple_scattering == MultipleScattering::Diffuse) {
         // The field (kept, and packed for the kernels), its sums while baking
         // (8 bytes each), and each view's light per voxel and band.
-        m.parts.push_back({"diffuse field", cells * cells * cells * coefficients * bands * (4 * 2 + 8)});
+        // Zonal degrees add theirs per zonal star (at most 4).
+        const int zonal = resolved_zonal(scene.diffuse, scene.dust.g);
+        const double zonal_coefficients =
+            zonal > scene.diffuse.order ? double(zonal - scene.diffuse.order) * double(std::min<size_t>(scene.stars.size(), 4)) : 0.0;
+        m.parts.push_back({"diffuse field", cells * cells * cells * (coefficients + zonal_coefficients) * bands * (4 * 2 + 8)});
         m.parts.push_back({"diffuse light per view", voxels * 4 * bands});
       }
     } else {

@@ -49,6 +49,8 @@ struct DiffuseReport {
   bool reused = false;  // taken over from an earlier preparation (its figures are that bake's)
   int shared_with = 0;  // other albedo sets baked by the same photon passes (a sweep; its figures are theirs)
   int order = 0;
+  int zonal = 0;               // zonal degrees of the brightest stars' light (0: none)
+  int zonal_stars = 0;
   GridShape cells;             // the field's cells ({along the axis, from it, 1} for an axial map)
   int voxels_per_cell = 1;     // along each axis
   bool axial = false;          // an axial map's field: photons on `photon_grid`, the map voxelized

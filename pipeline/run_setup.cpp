@@ -184,7 +184,9 @@ Image box_downsample(Image fine, int k) {
 // What the image's light between voxels came from, for its metadata.
 std::string multiple_scattering_text(const RunReport& r) {
   if (r.diffuse.done)
-    return std::string(r.diffuse.axial ? "axial " : "") + "diffuse order " + std::to_string(r.diffuse.order) + ", " + std::to_string(r.diffuse.cells.nx) + "x" +
+    return std::string(r.diffuse.axial ? "axial " : "") + "diffuse order " + std::to_string(r.diffuse.order) +
+           (r.diffuse.zonal > 0 ? " with zonal degrees to " + std::to_string(r.diffuse.zonal) : std::string()) + ", " +
+           std::to_string(r.diffuse.cells.nx) + "x" +
            std::to_string(r.diffuse.cells.ny) + "x" + std::to_string(r.diffuse.cells.nz) + " cells, " +
            std::to_string(r.diffuse.photons_per_band) + " photons per band";
   if (r.multiple_scattering == "pyramid") return "pyramid " + std::to_string(r.pyramid.size() - 1) + " levels";
@@ -206,6 +208,7 @@ std::vector<DiffuseBand> diffuse_bands(const SceneBands& bands, const BandTables
 DiffuseBakeOptions diffuse_options(const Scene& scene) {
   DiffuseBakeOptions options;
   options.degree = scene.diffuse.order;
+  options.zonal = resolved_zonal(scene.diffuse, scene.dust.g);
   options.cells = scene.diffuse.cells;
   options.photons = scene.diffuse.photons;
   options.seed = scene.diffuse.seed;
@@ -218,6 +221,8 @@ DiffuseReport diffuse_report(const std::vector<DiffuseBand>& bands, const Diffus
   DiffuseReport r;
   r.done = true;
   r.order = options.degree;
+  r.zonal = field.n_zonal() > 0 ? field.zonal : 0;
+  r.zonal_stars = r.zonal > 0 ? field.zonal_stars : 0;
   r.cells = field.cells;
   r.voxels_per_cell = voxels_per_cell;
   r.photons_per_band = options.photons;

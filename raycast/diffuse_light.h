@@ -27,7 +27,39 @@ NEBULA_HD void voxel_diffuse_light(const MarchScene& s, const Camera& camera, in
   if (!(tau_v > 0.0f)) return;
   const Vec3 centre = g.origin + g.voxel * Vec3{x + 0.5f, y + 0.5f, z + 0.5f};
   float D[kMaxBands][kDeg + 1];
-  s.diffuse.project<kDeg>(s.diffuse.cell_of(x, y, z), camera.to_eye(centre), D);
+  const size_t cell = s.diffuse.cell_of(x, y, z);
+  const Vec3 to_eye = camera.to_eye(centre);
+  s.diffuse.project<kDeg>(cell, to_eye, D);
+  const DiffuseView& f = s.diffuse;
+  const float w = f.zonal_weight(centre, to_eye);
+  if (w > 0.0f) {
+    // The zonal response: the harmonics' D_l below their degree, above it
+    // each zonal star's sums about the direction from it (to the voxel's
+    // centre; the deposits took each chord's middle); blended with the harmonics' own response by w.
+    const int n_zonal = f.zonal - kDeg;
+    float Dz[kMaxBands][kMaxZonalDegree + 1];
+    for (int b = 0; b < kMaxBands; ++b)
+      for (int l = 0; l <= f.zonal; ++l) Dz[b][l] = l <= kDeg ? D[b][l] : 0.0f;
+    const float* c = f.packed + cell * size_t(f.coeffs) * 4;
+    for (int k = 0; k < f.zonal_stars; ++k) {
+      const Vec3 r = centre - f.zonal_star[k];
+      const float len = length(r);
+      const float mu = len > 0.0f ? dot(to_eye, r) / len : to_eye.z;
+      float yz[kMaxZonalDegree];
+      zonal_basis(kDeg + 1, f.zonal, mu, yz);
+      const float* block = c + size_t(sh_count(kDeg) + k * n_zonal) * 4;
+      for (int j = 0; j < n_zonal; ++j)
+        for (int b = 0; b < kMaxBands; ++b) Dz[b][kDeg + 1 + j] += yz[j] * block[4 * j + b];
+    }
+    for (int b = 0; b < kMaxBands; ++b)
+      if (b < s.n_bands && f.has[b]) {
+        const float tau_sct = s.albedo[b] * tau_v * s.extinction_ratio[b];
+        float peak = 0.0f;
+        const float own = f.scattered<kDeg>(b, tau_sct, D[b], &peak);
+        light[b] = fmaxf(0.0f, own + w * (f.scattered_zonal(b, tau_sct, Dz[b]) - own));
+      }
+    return;
+  }
   NEBULA_UNROLL
   for (int b = 0; b < kMaxBands; ++b)
     if (b < s.n_bands && s.diffuse.has[b]) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 
 #include "diffuse/diffuse_bake.h"
 #include "raycast/renderer.h"
@@ -17,7 +18,7 @@ using testing::OneStarScene;
 using testing::telescope;
 using testing::thin_table;
 
-DiffuseField bake(const OneStarScene& s, float g, uint64_t photons, DiffuseBakeStats* stats = nullptr) {
+DiffuseField bake(const OneStarScene& s, float g, uint64_t photons, DiffuseBakeStats* stats = nullptr, int zonal = 0) {
   DiffuseBand band;
   static_cast<Band&>(band) = s.inputs.bands[0];
   band.g = g;
@@ -25,6 +26,7 @@ DiffuseField bake(const OneStarScene& s, float g, uint64_t photons, DiffuseBakeS
   DiffuseBakeOptions o;
   o.photons = photons;
   o.cells = 16;
+  o.zonal = zonal;
   return bake_diffuse(s.grid, {band}, {static_cast<const StarLight&>(s.inputs.stars[0])}, o, Backend::Cpu, stats);
 }
 
@@ -58,7 +60,9 @@ double mean_escape(const DensityGrid& grid, Vec3 star) {
 // photon sum (1 / sqrt(photons)). Without the diffuse field the image must
 // miss more than that, so the test can tell the two apart.
 TEST(DiffuseRender, ConservesEnergyAtAlbedoOne) {
-  for (float g : {0.0f, 0.6f}) {
+  // Strongly forward dust with and without the zonal degrees (docs/diffuse.md).
+  const std::pair<float, int> cases[] = {{0.0f, 0}, {0.6f, 0}, {0.9f, 0}, {0.9f, 24}};
+  for (const auto& [g, zonal] : cases) {
     OneStarScene s;
     s.grid = cube(32, 1.0f);
     const float radius = 0.8f;
@@ -69,7 +73,7 @@ TEST(DiffuseRender, ConservesEnergyAtAlbedoOne) {
     s.finish({0.01f, 0.02f, 0.015f}, power, 1.0f, telescope(pixels, 2.0f));
     s.inputs.bands[0].g = g;
     const uint64_t photons = 1u << 18;
-    const DiffuseField field = bake(s, g, photons);
+    const DiffuseField field = bake(s, g, photons, nullptr, zonal);
     const double expected = power * (1 - mean_escape(s.grid, s.inputs.stars[0].position)) / (4 * kPiD);
     const double pixel_area = std::pow(2.0 / pixels, 2);
     auto total = [&](const Image& im) {
@@ -83,9 +87,9 @@ TEST(DiffuseRender, ConservesEnergyAtAlbedoOne) {
     const Image image = render_cpu(s.inputs, nullptr);
     const double with = total(image);
     const double allowed = 0.05 + 4 / std::sqrt(double(photons));
-    std::printf("g %.1f: scattered light %.4g, expected %.4g (ratio %.4f, allowed +-%.3f); without the field %.4f\n",
-                g, with, expected, with / expected, allowed, without / expected);
-    EXPECT_NEAR(with / expected, 1.0, allowed) << "g " << g;
+    std::printf("g %.1f, zonal %d: scattered light %.4g, expected %.4g (ratio %.4f, allowed +-%.3f); without the field %.4f\n",
+                g, zonal, with, expected, with / expected, allowed, without / expected);
+    EXPECT_NEAR(with / expected, 1.0, allowed) << "g " << g << " zonal " << zonal;
     EXPECT_LT(without / expected, 1.0 - allowed) << "the test must tell the field from no field";
   }
 }

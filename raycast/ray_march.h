@@ -209,8 +209,9 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchM
             for (int b = 0; b < s.n_bands; ++b)
               if (s.diffuse_light[b]) {
                 local[b] += sample_field(g, s.diffuse_light[b], pos, mode.trilinear);
-                peak[b] += s.diffuse.peak(b, s.albedo[b] * tau_sample * s.extinction_ratio[b]) * step /
-                           fmaxf(chord, 1e-30f);
+                peak[b] += s.diffuse.peak(b, s.albedo[b] * tau_sample * s.extinction_ratio[b],
+                                          s.diffuse.zonal_weight(pos, to_eye)) *
+                           step / fmaxf(chord, 1e-30f);
               }
         }
         for (int b = 0; b < s.n_bands; ++b) source[b] += local[b] * step / fmaxf(chord, 1e-30f);
@@ -221,9 +222,11 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchM
         if (b < s.n_bands) source[b] = s.voxel_source[b][cell];
       if constexpr (kDiffuse) {
         if (tau_v > 0.0f) {
+          const float w = s.diffuse.zonal_weight(origin + (t + 0.5f * chord) * dir, to_eye);
           NEBULA_UNROLL
           for (int b = 0; b < kMaxBands; ++b)
-            if (b < s.n_bands && s.diffuse.has[b]) peak[b] = s.diffuse.peak(b, s.albedo[b] * tau_v * s.extinction_ratio[b]);
+            if (b < s.n_bands && s.diffuse.has[b])
+              peak[b] = s.diffuse.peak(b, s.albedo[b] * tau_v * s.extinction_ratio[b], w);
         }
       }
     } else {
@@ -238,11 +241,14 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchM
       }
       if constexpr (kDiffuse) {
         if (tau_v > 0.0f) {
+          // The zonal response's weight (0 without zonal degrees): its peak
+          // blends with the harmonics' own as the per-view light did.
+          const float w = s.diffuse.zonal_weight(origin + (t + 0.5f * chord) * dir, to_eye);
           NEBULA_UNROLL
           for (int b = 0; b < kMaxBands; ++b)
             if (b < s.n_bands && s.diffuse_light[b]) {
               source[b] += s.diffuse_light[b][cell];
-              peak[b] = s.diffuse.peak(b, s.albedo[b] * tau_v * s.extinction_ratio[b]);
+              peak[b] = s.diffuse.peak(b, s.albedo[b] * tau_v * s.extinction_ratio[b], w);
             }
         }
       }

@@ -15,6 +15,16 @@
 
 namespace nebula {
 
+int resolved_zonal(const DiffuseSettings& d, const std::vector<double>& g) {
+  if (d.zonal != DiffuseSettings::kZonalAuto) return d.zonal;
+  // Strongly forward dust only: at g = 0.9 the harmonics alone misplace the
+  // light near a star by 20-30% per pixel, at g = 0.6 the zonal degrees
+  // change little (docs/diffuse.md, "Zonal degrees").
+  for (double x : g)
+    if (x >= 0.8) return std::max(24, d.order + 1);
+  return 0;
+}
+
 const char* to_string(MultipleScattering mode) {
   switch (mode) {
     case MultipleScattering::Diffuse: return "diffuse";
@@ -236,6 +246,10 @@ std::optional<SceneIssue> settings_issue(const Scene& s) {
                                            "\": levels belong to the pyramid (set multiple_scattering = \"pyramid\")"};
   if (s.diffuse.order < 0 || s.diffuse.order > 4)
     return SceneIssue{"render.diffuse_order", "is " + std::to_string(s.diffuse.order) + "; must be in 0..4"};
+  if (s.diffuse.zonal != 0 && s.diffuse.zonal != DiffuseSettings::kZonalAuto &&
+      (s.diffuse.zonal <= s.diffuse.order || s.diffuse.zonal > 32))
+    return SceneIssue{"render.diffuse_zonal", "is " + std::to_string(s.diffuse.zonal) +
+                                                  "; must be \"auto\", 0 (none) or above render.diffuse_order, at most 32"};
   if (s.diffuse.cells < 1 || s.diffuse.cells > 4096)
     return SceneIssue{"render.diffuse_cells", "is " + std::to_string(s.diffuse.cells) + "; must be in 1..4096"};
   if (s.diffuse.photons < 1 || s.diffuse.photons > 0xFFFFFFFFull)

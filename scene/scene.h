@@ -100,9 +100,16 @@ bool parse_multiple_scattering(const std::string& name, MultipleScattering& out)
 struct DiffuseSettings {
   int order = 3;                 // harmonics' degree, 0 to 4
   int cells = 64;                // field cells along the grid's longest axis (at least)
+  // Zonal degrees of the brightest stars' light (docs/diffuse.md): 0 none,
+  // else order + 1 to 32; kZonalAuto: 24 when a band's g >= 0.8, else none.
+  static constexpr int kZonalAuto = -1;
+  int zonal = kZonalAuto;
   uint64_t photons = 1u << 20;   // per band
   uint64_t seed = 1;
 };
+
+// The zonal degree a scene's field uses (resolving "auto" by the bands' g).
+int resolved_zonal(const DiffuseSettings& d, const std::vector<double>& g);
 
 // A filter read from a file the scene names ([filters] in a scene file): a
 // band like the built-in filters (illumination/filters.h).

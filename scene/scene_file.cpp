@@ -67,7 +67,7 @@ const std::initializer_list<std::string_view> kTopKeys = {"bands",  "density", "
 const std::initializer_list<std::string_view> kSpectralKeys = {
     "method", "basis", "wavelengths", "attenuation", "norm", "fit_depth", "max_depth", "range_um", "near_voxels"};
 const std::initializer_list<std::string_view> kRenderKeys = {
-    "levels", "multiple_scattering", "diffuse_order", "diffuse_cells", "diffuse_photons", "diffuse_seed",
+    "levels", "multiple_scattering", "diffuse_order", "diffuse_zonal", "diffuse_cells", "diffuse_photons", "diffuse_seed",
     "samples_per_pixel"};
 const std::initializer_list<std::string_view> kAxialKeys = {
     "synthetic", "file", "image", "dataset", "emission_prefix", "tau_channel", "emission_channels", "nx", "nr",
@@ -804,6 +804,14 @@ void Parser::parse_render(const toml::table& root, Scene& scene) const {
   }
   DiffuseSettings& d = scene.diffuse;
   if (const toml::node* v = t.get("diffuse_order")) d.order = small_integer(*v, "render.diffuse_order");
+  if (const toml::node* v = t.get("diffuse_zonal")) {
+    if (v->is_string() && lower(string(*v, "render.diffuse_zonal")) == "auto")
+      d.zonal = DiffuseSettings::kZonalAuto;
+    else if (v->is_string())
+      fail("render.diffuse_zonal", "must be \"auto\" or a whole number, got '" + string(*v, "render.diffuse_zonal") + "'");
+    else
+      d.zonal = small_integer(*v, "render.diffuse_zonal");
+  }
   if (const toml::node* v = t.get("diffuse_cells")) d.cells = small_integer(*v, "render.diffuse_cells");
   auto count = [&](const char* name, uint64_t& out) {
     const toml::node* v = t.get(name);

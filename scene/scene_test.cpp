@@ -373,6 +373,24 @@ TEST_F(SceneFile, RefusesBadDust) {
   refused("bands_twice", std::string("bands = [\"B\", \"B\"]\n") + kBase, {"bands", "twice"});
 }
 
+// render.diffuse_zonal: "auto" (the default: 24 when a band's g >= 0.8), a
+// whole number above diffuse_order up to 32, or 0; anything else refused by name.
+TEST_F(SceneFile, DiffuseZonalIsAutoOrAWholeNumberAboveTheOrder) {
+  const Scene base = load_scene(write_text("zonal_base.toml", kBase));
+  EXPECT_EQ(base.diffuse.zonal, DiffuseSettings::kZonalAuto);
+  EXPECT_EQ(resolved_zonal(base.diffuse, base.dust.g), 0) << "g = 0.6 in every band";
+  EXPECT_EQ(resolved_zonal(base.diffuse, {0.6, 0.85, 0.6}), 24) << "one band of strongly forward dust";
+  const Scene fixed = load_scene(write_text("zonal_12.toml", kBase + std::string("\n[render]\ndiffuse_zonal = 12\n")));
+  EXPECT_EQ(resolved_zonal(fixed.diffuse, {0.9}), 12);
+  const Scene none = load_scene(write_text("zonal_0.toml", kBase + std::string("\n[render]\ndiffuse_zonal = 0\n")));
+  EXPECT_EQ(resolved_zonal(none.diffuse, {0.9}), 0);
+  const Scene spelled = load_scene(write_text("zonal_auto.toml", kBase + std::string("\n[render]\ndiffuse_zonal = \"AUTO\"\n")));
+  EXPECT_EQ(spelled.diffuse.zonal, DiffuseSettings::kZonalAuto);
+  refused("zonal_word", kBase + std::string("\n[render]\ndiffuse_zonal = \"many\"\n"), {"render.diffuse_zonal", "auto"});
+  refused("zonal_low", kBase + std::string("\n[render]\ndiffuse_zonal = 3\n"), {"render.diffuse_zonal", "above render.diffuse_order"});
+  refused("zonal_high", kBase + std::string("\n[render]\ndiffuse_zonal = 40\n"), {"render.diffuse_zonal", "at most 32"});
+}
+
 TEST_F(SceneFile, RefusesBadCameras) {
   refused("zero_view", edited("look_at = [1.0, 1.0, 1.0]", "look_at = [1.0, -3.0, 1.0]"), {"camera.look_at", "zero length"});
   refused("up_parallel", edited("[camera]\n", "[camera]\nup = [0, 2, 0]\n"), {"camera.up", "parallel"});

@@ -192,7 +192,7 @@ std::vector<RenderBenchRow> bench_render(Backend backend, int size, int width, i
 }
 
 DiffuseBench bench_diffuse(Backend backend, int size, int width, int height, int repeats, int degree, int cells,
-                           uint64_t photons) {
+                           uint64_t photons, int zonal) {
   const BenchNebula nebula(backend, size, width, height);
   const std::vector<Vec3> positions{nebula.star(0)};
   DiffuseBench out;
@@ -215,6 +215,7 @@ DiffuseBench bench_diffuse(Backend backend, int size, int width, int height, int
   for (const BakedStar& s : in.stars) stars.push_back(s);
   DiffuseBakeOptions o;
   o.degree = degree;
+  o.zonal = zonal;
   o.cells = cells;
   o.photons = photons;
   DiffuseBakeStats stats;

@@ -83,7 +83,7 @@ struct DiffuseBench {
   double noise = 0;  // relative L2 noise of the V band's l = 0 part
 };
 DiffuseBench bench_diffuse(Backend backend, int size, int width, int height, int repeats, int degree, int cells,
-                           uint64_t photons);
+                           uint64_t photons, int zonal = 0);
 
 // The cost of each pyramid level on the same nebula with one star: the
 // one-time build and bake per level, and per frame the median render time of
