@@ -90,10 +90,15 @@ DiffusePassResult diffuse_pass_cpu(const DiffusePassInputs& in, uint64_t photons
     PhotonCounters c;
     auto trace = [&](auto&& deposit, auto&& deposit_odd) {
       for (uint64_t p = range.begin(); p != range.end(); ++p) {
-        if (scene.slots > 1)
-          trace_diffuse_photon<true>(scene, static_cast<uint32_t>(p), deposit, deposit_odd, c);
+        const uint32_t i = static_cast<uint32_t>(p);
+        if (scene.slots > 1 && scene.zonal > 0)
+          trace_diffuse_photon<true, true>(scene, i, deposit, deposit_odd, c);
+        else if (scene.slots > 1)
+          trace_diffuse_photon<true, false>(scene, i, deposit, deposit_odd, c);
+        else if (scene.zonal > 0)
+          trace_diffuse_photon<false, true>(scene, i, deposit, deposit_odd, c);
         else
-          trace_diffuse_photon<false>(scene, static_cast<uint32_t>(p), deposit, deposit_odd, c);
+          trace_diffuse_photon<false, false>(scene, i, deposit, deposit_odd, c);
       }
     };
     if (private_sums) {

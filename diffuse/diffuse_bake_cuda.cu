@@ -17,13 +17,13 @@
 namespace nebula {
 namespace {
 
-template <bool kShared>
+template <bool kShared, bool kZonal>
 __global__ void diffuse_photon_kernel(DiffusePhotonScene scene, uint64_t photons, unsigned long long* sums,
                                       unsigned long long* odd, unsigned long long* counters) {
   PhotonCounters c;
   const uint64_t stride = uint64_t(gridDim.x) * blockDim.x;
   for (uint64_t p = uint64_t(blockIdx.x) * blockDim.x + threadIdx.x; p < photons; p += stride)
-    trace_diffuse_photon<kShared>(
+    trace_diffuse_photon<kShared, kZonal>(
         scene, static_cast<uint32_t>(p), [&](size_t i, unsigned long long v) { atomicAdd(&sums[i], v); },
         [&](size_t i, unsigned long long v) { atomicAdd(&odd[i], v); }, c);
   atomicAdd(&counters[0], static_cast<unsigned long long>(c.collisions));
@@ -136,10 +136,15 @@ std::vector<DiffusePassResult> diffuse_passes_cuda(const std::vector<DiffusePass
     }
     DiffusePassResult r;
     CudaEventTimer timer;
-    if (scene.slots > 1)
-      diffuse_photon_kernel<true><<<blocks, block>>>(scene, photons, sums.get(), odd.get(), counters.get());
+    auto launch = [&](auto kernel) { kernel<<<blocks, block>>>(scene, photons, sums.get(), odd.get(), counters.get()); };
+    if (scene.slots > 1 && scene.zonal > 0)
+      launch(diffuse_photon_kernel<true, true>);
+    else if (scene.slots > 1)
+      launch(diffuse_photon_kernel<true, false>);
+    else if (scene.zonal > 0)
+      launch(diffuse_photon_kernel<false, true>);
     else
-      diffuse_photon_kernel<false><<<blocks, block>>>(scene, photons, sums.get(), odd.get(), counters.get());
+      launch(diffuse_photon_kernel<false, false>);
     NEBULA_CUDA_CHECK(cudaGetLastError());
     r.seconds = timer.seconds();
     const size_t entries = harmonics * size_t(slots);

@@ -149,8 +149,10 @@ NEBULA_HD Vec3 point_at_depth(const DensityView& d, float ratio, Vec3 origin, Ve
 // accumulator `index` = cell * n_coeffs + k. `odd` receives the l = 0 deposits
 // of odd photons again (the field's noise from its two halves).
 // kShared: the scene has several slots (DiffuseSlots); false compiles the
-// plain pass, with nothing of the slots in it.
-template <bool kShared = false, class Deposit, class DepositOdd>
+// plain pass, with nothing of the slots in it. kZonal: the scene has zonal
+// degrees (their deposits are a separate instantiation too: a local array
+// of them per crossing tripled the plain pass's time on the GPU).
+template <bool kShared = false, bool kZonal = false, class Deposit, class DepositOdd>
 NEBULA_HD void trace_diffuse_photon(const DiffusePhotonScene& s, uint32_t photon, Deposit&& deposit,
                                     DepositOdd&& deposit_odd, PhotonCounters& c) {
   if (s.n_stars == 0 || !(s.albedo > 0.0f)) return;
@@ -233,31 +235,33 @@ NEBULA_HD void trace_diffuse_photon(const DiffusePhotonScene& s, uint32_t photon
     if (t_end > t_start) {
       sh_basis(s.degree, dir, y);
       const float inv_edge = 1.0f / s.cells.voxel;
-      const int n_zonal = (s.zonal > s.degree && k < s.zonal_stars) ? s.zonal - s.degree : 0;
-      const int zonal_at = s.n_sh + k * (s.zonal - s.degree);
-      const Vec3 star = origin;
+      [[maybe_unused]] const int n_zonal = kZonal && s.zonal > s.degree && k < s.zonal_stars ? s.zonal - s.degree : 0;
+      [[maybe_unused]] const int zonal_at = s.n_sh + k * (s.zonal - s.degree);
       const Vec3 seg_start = pos + t_start * dir;
-      float along = 0.0f;  // the chord's start, from seg_start
+      [[maybe_unused]] float along = 0.0f;  // the chord's start, from seg_start (zonal degrees)
       traverse_segment_cells(s.cells, seg_start, pos + t_end * dir,
                              [&](int, int, int, size_t cell, float chord) {
                                ++c.crossings;
                                const float w_all = weight * chord * inv_edge * kDiffuseFixedScale;
-                               float z[kMaxZonalDegree];
-                               const float mid = along + 0.5f * chord;
-                               along += chord;
-                               if (n_zonal > 0) {
-                                 // About the direction from the star to the chord's middle.
-                                 const Vec3 r = seg_start + mid * dir - star;
-                                 const float len = length(r);
-                                 const float mu = len > 0.0f ? dot(dir, r) / len : dir.z;
-                                 zonal_basis(s.degree + 1, s.zonal, mu, z);
+                               [[maybe_unused]] float z[kZonal ? kMaxZonalDegree : 1];
+                               if constexpr (kZonal) {
+                                 const float mid = along + 0.5f * chord;
+                                 along += chord;
+                                 if (n_zonal > 0) {
+                                   // About the direction from the star to the chord's middle.
+                                   const Vec3 r = seg_start + mid * dir - origin;
+                                   const float len = length(r);
+                                   zonal_basis(s.degree + 1, s.zonal, len > 0.0f ? dot(dir, r) / len : dir.z, z);
+                                 }
                                }
                                // Entry 0 of the cell's block at `base`, weight w.
                                auto put = [&](size_t base, float w) {
                                  for (int j = 0; j < s.n_sh; ++j)
                                    deposit(base + size_t(j), static_cast<unsigned long long>(llrintf(w * y[j])));
-                                 for (int j = 0; j < n_zonal; ++j)
-                                   deposit(base + size_t(zonal_at + j), static_cast<unsigned long long>(llrintf(w * z[j])));
+                                 if constexpr (kZonal)
+                                   for (int j = 0; j < n_zonal; ++j)
+                                     deposit(base + size_t(zonal_at + j),
+                                             static_cast<unsigned long long>(llrintf(w * z[j])));
                                };
                                if constexpr (!kShared) {
                                  put(cell * size_t(s.n_coeffs), w_all);

@@ -31,8 +31,8 @@ SCENES = ["fig12_reference", "thin_nebula", "thick_nebula", "layer_front", "laye
           "sphere_tau5", "axial_lopsided", "axial_lopsided_thick"]
 METHODS = {
     "diffuse (default)": [],
-    "diffuse, harmonics only": ["--set", "render.diffuse_zonal=0"],
-    "diffuse, zonal 24 at every g": ["--set", "render.diffuse_zonal=24"],
+    "diffuse harmonics only": ["--set", "render.diffuse_zonal=0"],
+    "diffuse zonal 24 at every g": ["--set", "render.diffuse_zonal=24"],
     "pyramid 1 level": ["--levels", "1"],
     "pyramid 2 levels": ["--levels", "2"],
     "pyramid 3 levels": ["--levels", "3"],
