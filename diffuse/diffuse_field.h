@@ -149,21 +149,15 @@ struct DiffuseView {
     return s[0] + f * (s[1] - s[0]);
   }
 
-  // With zonal degrees: D[l] for l <= zonal (the harmonics' D_l below the
-  // field's degree, the zonal stars' sums above it); the zonal response
-  // sum_l r_l(tau_sct) D_l, each row's sum interpolated.
-  NEBULA_HD float scattered_zonal(int b, float tau_sct, const float* D) const {
+  // Band b's response row below tau_sct (the zonal response first when
+  // there are zonal degrees; the row above it is `stride` floats on), and in
+  // *frac where tau_sct lies between them (clamped to the table, as lookups are).
+  NEBULA_HD const float* response_row(int b, float tau_sct, float* frac) const {
     const float u = fminf(fmaxf(tau_sct * rows_per_tau[b], 0.0f), float(rows[b] - 1));
     int i = static_cast<int>(u);
     i = i > rows[b] - 2 ? rows[b] - 2 : i;
-    const float f = u - float(i);
-    const float* r0 = response[b] + size_t(i) * stride;
-    float s0 = 0.0f, s1 = 0.0f;
-    for (int l = 0; l <= zonal; ++l) {
-      s0 += r0[l] * D[l];
-      s1 += r0[stride + l] * D[l];
-    }
-    return s0 + f * (s1 - s0);
+    *frac = u - float(i);
+    return response[b] + size_t(i) * stride;
   }
 
   // How much of a voxel's response at p, seen from to_eye (unit), is the

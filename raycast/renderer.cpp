@@ -63,11 +63,13 @@ Image render_cpu(const RenderInputs& in, RenderStats* stats) {
       scene.voxel_source[b] = planes.band[b];
     }
     dispatch_source_degree(scene, [&](auto degree) {
-      tbb::parallel_for(tbb::blocked_range<int>(0, g.ny * g.nz), [&](const auto& rows) {
-        int local = 0;
-        for (int r = rows.begin(); r != rows.end(); ++r)
-          local += voxel_source_row<degree()>(scene, in.camera, r % g.ny, r / g.ny, 0, g.nx, planes);
-        clamps += uint64_t(local);
+      dispatch_zonal(scene, [&](auto zonal) {
+        tbb::parallel_for(tbb::blocked_range<int>(0, g.ny * g.nz), [&](const auto& rows) {
+          int local = 0;
+          for (int r = rows.begin(); r != rows.end(); ++r)
+            local += voxel_source_row<degree(), zonal()>(scene, in.camera, r % g.ny, r / g.ny, 0, g.nx, planes);
+          clamps += uint64_t(local);
+        });
       });
     });
   } else if (scene.has_diffuse) {
@@ -80,9 +82,11 @@ Image render_cpu(const RenderInputs& in, RenderStats* stats) {
         scene.diffuse_light[b] = planes.band[b];
       }
     dispatch_diffuse_degree(scene.diffuse.degree, [&](auto degree) {
-      tbb::parallel_for(tbb::blocked_range<int>(0, g.ny * g.nz), [&](const auto& rows) {
-        for (int r = rows.begin(); r != rows.end(); ++r)
-          diffuse_light_row<degree()>(scene, in.camera, r % g.ny, r / g.ny, 0, g.nx, planes);
+      dispatch_zonal(scene, [&](auto zonal) {
+        tbb::parallel_for(tbb::blocked_range<int>(0, g.ny * g.nz), [&](const auto& rows) {
+          for (int r = rows.begin(); r != rows.end(); ++r)
+            diffuse_light_row<degree(), zonal()>(scene, in.camera, r % g.ny, r / g.ny, 0, g.nx, planes);
+        });
       });
     });
   }

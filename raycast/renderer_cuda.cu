@@ -32,25 +32,25 @@ namespace {
 
 // One thread per voxel: the diffuse field's light towards this view's eye
 // (raycast/diffuse_light.h).
-template <int kDeg>
+template <int kDeg, bool kZonal>
 __global__ void diffuse_light_kernel(MarchScene scene, Camera camera, DiffuseLightPlanes out) {
   const GridShape& g = scene.density.shape;
   const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i >= g.count()) return;
   const int x = int(i % size_t(g.nx)), y = int(i / size_t(g.nx) % size_t(g.ny)), z = int(i / (size_t(g.nx) * g.ny));
-  diffuse_light_row<kDeg>(scene, camera, y, z, x, x + 1, out);
+  diffuse_light_row<kDeg, kZonal>(scene, camera, y, z, x, x + 1, out);
 }
 
 // One thread per voxel: the preview's light of each voxel towards this view's
 // eye (raycast/voxel_sources.h).
-template <int kDeg>
+template <int kDeg, bool kZonal>
 __global__ void voxel_source_kernel(MarchScene scene, Camera camera, VoxelSourcePlanes out,
                                     unsigned long long* clamps) {
   const GridShape& g = scene.density.shape;
   const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i >= g.count()) return;
   const int x = int(i % size_t(g.nx)), y = int(i / size_t(g.nx) % size_t(g.ny)), z = int(i / (size_t(g.nx) * g.ny));
-  const int n = voxel_source_row<kDeg>(scene, camera, y, z, x, x + 1, out);
+  const int n = voxel_source_row<kDeg, kZonal>(scene, camera, y, z, x, x + 1, out);
   if (n) atomicAdd(clamps, static_cast<unsigned long long>(n));
 }
 
@@ -124,7 +124,9 @@ double render_cuda_to_device(const RenderInputs& in, float* pixels, unsigned lon
       scene.voxel_source[b] = sources.band[b];
     }
     dispatch_source_degree(scene, [&](auto degree) {
-      voxel_source_kernel<degree()><<<voxel_blocks, 256>>>(scene, in.camera, sources, clamps);
+      dispatch_zonal(scene, [&](auto zonal) {
+        voxel_source_kernel<degree(), zonal()><<<voxel_blocks, 256>>>(scene, in.camera, sources, clamps);
+      });
     });
     NEBULA_CUDA_CHECK(cudaGetLastError());
   } else if (scene.has_diffuse) {
@@ -137,7 +139,9 @@ double render_cuda_to_device(const RenderInputs& in, float* pixels, unsigned lon
         scene.diffuse_light[b] = planes.band[b];
       }
     dispatch_diffuse_degree(scene.diffuse.degree, [&](auto degree) {
-      diffuse_light_kernel<degree()><<<voxel_blocks, 256>>>(scene, in.camera, planes);
+      dispatch_zonal(scene, [&](auto zonal) {
+        diffuse_light_kernel<degree(), zonal()><<<voxel_blocks, 256>>>(scene, in.camera, planes);
+      });
     });
     NEBULA_CUDA_CHECK(cudaGetLastError());
   }

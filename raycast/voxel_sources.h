@@ -21,7 +21,7 @@ namespace nebula {
 // Voxel (x, y, z)'s light towards the eye per band, per unit of chord / l:
 // emission + sum over stars of E P(tau_sct, theta) + the diffuse field's
 // light (kDeg its degree; -1: no field). Table clamps are counted in *clamps.
-template <int kDeg>
+template <int kDeg, bool kZonal = false>
 NEBULA_HD void voxel_source(const MarchScene& s, const Camera& camera, int x, int y, int z, float (&out)[kMaxBands],
                             int* clamps) {
   const GridShape& g = s.density.shape;
@@ -37,7 +37,7 @@ NEBULA_HD void voxel_source(const MarchScene& s, const Camera& camera, int x, in
                    point_irradiance(centre, s.stars[k].position, g.voxel), tau_v, to_eye, out, clamps);
   if constexpr (kDeg >= 0) {
     float light[kMaxBands];
-    voxel_diffuse_light<kDeg>(s, camera, x, y, z, light);
+    voxel_diffuse_light<kDeg, kZonal>(s, camera, x, y, z, light);
     NEBULA_UNROLL
     for (int b = 0; b < kMaxBands; ++b)
       if (b < s.n_bands) out[b] += light[b];
@@ -51,14 +51,14 @@ struct VoxelSourcePlanes {
 
 // Voxels x_begin..x_end - 1 of row (y, z): the unit of work of the CPU loop
 // (a row) and the CUDA kernel (a voxel). Returns the table clamps.
-template <int kDeg>
+template <int kDeg, bool kZonal = false>
 NEBULA_HD int voxel_source_row(const MarchScene& s, const Camera& camera, int y, int z, int x_begin, int x_end,
                                const VoxelSourcePlanes& out) {
   const GridShape& g = s.density.shape;
   int clamps = 0;
   for (int x = x_begin; x < x_end; ++x) {
     float source[kMaxBands];
-    voxel_source<kDeg>(s, camera, x, y, z, source, &clamps);
+    voxel_source<kDeg, kZonal>(s, camera, x, y, z, source, &clamps);
     const size_t cell = g.index(x, y, z);
     NEBULA_UNROLL
     for (int b = 0; b < kMaxBands; ++b)
