@@ -34,6 +34,16 @@ ScatteringTable thin_table(double g) {
   return t;
 }
 
+// Band V of the given dust, answering through `table`.
+DiffuseBand v_band(float albedo, float g, const ScatteringTable& table) {
+  DiffuseBand band;
+  band.name = "V";
+  band.albedo = albedo;
+  band.g = g;
+  band.table = &table;
+  return band;
+}
+
 // Entry and exit distances of the ray s + t d (unit d) through the box [lo, hi]; false when it misses.
 bool box_interval(const double s[3], const double d[3], const double lo[3], const double hi[3], double& t0, double& t1) {
   t0 = -1e300;
@@ -158,11 +168,7 @@ TEST(DiffuseBake, FirstScatteredFieldIsTheSingleScatteringIntegral) {
 TEST(DiffuseBake, TheSameFieldOnOneThreadOrMany) {
   const DensityGrid grid = cube(8, 0.3f);
   const ScatteringTable table = thin_table(0.6);
-  DiffuseBand band;
-  band.name = "V";
-  band.albedo = 0.8f;
-  band.g = 0.6f;
-  band.table = &table;
+  const DiffuseBand band = v_band(0.8f, 0.6f, table);
   DiffuseBakeOptions o;
   o.photons = 20000;
   const std::vector<StarLight> stars{{{0.1f, -0.2f, 0.3f}, {1.0f}}};
@@ -189,11 +195,7 @@ TEST(DiffuseBake, TheSameFieldOnOneThreadOrMany) {
 TEST(DiffuseBakeZonal, AddToTheHarmonicsAndAreTheirDegreesAlongTheStarsDirection) {
   const DensityGrid grid = cube(16, 0.08f);
   const ScatteringTable table = thin_table(0.9);
-  DiffuseBand band;
-  band.name = "V";
-  band.albedo = 0.8f;
-  band.g = 0.9f;
-  band.table = &table;
+  const DiffuseBand band = v_band(0.8f, 0.9f, table);
   const Vec3 star{0.0f, 0.0f, 0.0f};
   const std::vector<StarLight> stars{{star, {1.0f}}};
   DiffuseBakeOptions o;
@@ -242,11 +244,7 @@ TEST(DiffuseBakeZonal, AddToTheHarmonicsAndAreTheirDegreesAlongTheStarsDirection
 TEST(DiffuseBake, NoiseFallsAsOneOverTheRootOfThePhotons) {
   const DensityGrid grid = cube(8, 0.2f);
   const ScatteringTable table = thin_table(0.6);
-  DiffuseBand band;
-  band.name = "V";
-  band.albedo = 0.6f;
-  band.g = 0.6f;
-  band.table = &table;
+  const DiffuseBand band = v_band(0.6f, 0.6f, table);
   DiffuseBakeOptions o;
   const std::vector<StarLight> stars{{{0.0f, 0.0f, 0.0f}, {1.0f}}};
   DiffuseBakeStats few, more;
@@ -464,11 +462,7 @@ TEST(DiffuseBake, HardCasesStayFinite) {
       for (Vec3 star : {Vec3{0.0f, 0.0f, 0.0f}, Vec3{0.1f, 0.1f, 0.1f}, Vec3{3.0f, 0.2f, -0.1f}})
         for (const DensityGrid* d : {static_cast<const DensityGrid*>(&grid), &empty}) {
           const ScatteringTable table = thin_table(g);
-          DiffuseBand band;
-          band.name = "V";
-          band.albedo = albedo;
-          band.g = g;
-          band.table = &table;
+          const DiffuseBand band = v_band(albedo, g, table);
           DiffuseBakeStats stats;
           const DiffuseField f = bake_diffuse(*d, {band}, {{star, {10.0f}}}, o, Backend::Cpu, &stats);
           const std::vector<float> c = f.band_coeffs(0);
