@@ -128,12 +128,4 @@ NEBULA_HD void diffuse_light_row(const MarchScene& s, const Camera& camera, int 
   }
 }
 
-// Calls f(std::true_type) when the scene's field has zonal degrees, else
-// f(std::false_type): the one place that makes it a template argument.
-template <class F>
-decltype(auto) dispatch_zonal(const MarchScene& s, F&& f) {
-  if (s.has_diffuse && s.diffuse.zonal > 0) return f(std::true_type{});
-  return f(std::false_type{});
-}
-
 }  // namespace nebula

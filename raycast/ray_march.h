@@ -160,10 +160,13 @@ struct MarchMode {
 // evaluated for this view (raycast/diffuse_light.h): it adds to the voxel's
 // source as emission does, and its forward peak to the voxel's transmittance.
 // kVoxelSources: the preview, each voxel's light read from s.voxel_source
-// (exact traversal only).
-template <bool kSmooth, bool kDiffuse, bool kVoxelSources = false>
+// (exact traversal only). kZonal: the field has zonal degrees (its peak
+// blends towards the zonal response, DiffuseView::zonal_weight); without
+// them the kernel carries none of that code.
+template <bool kSmooth, bool kDiffuse, bool kVoxelSources = false, bool kZonal = false>
 NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchMode mode) {
   static_assert(!(kSmooth && kVoxelSources), "the preview's voxel sources go with the exact traversal");
+  static_assert(kDiffuse || !kZonal, "zonal degrees belong to a diffuse field");
   RayResult out{};
   for (int b = 0; b < kMaxBands; ++b) out.transmittance[b] = 1.0f;
   const GridShape& g = s.density.shape;
@@ -176,6 +179,8 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchM
   const float inv_voxel = 1.0f / g.voxel;
   const float step = mode.step_voxels * g.voxel;
   const Vec3 to_eye = -dir;
+  // The zonal response's weight at p (0 without zonal degrees, at compile time).
+  auto zonal_weight = [&](Vec3 p) { return kZonal ? s.diffuse.zonal_weight(p, to_eye) : 0.0f; };
   float t = t_enter;  // where the current voxel begins along the ray
   traverse_segment_cells(g, origin, origin + far * dir, [&](int, int, int, size_t cell, float chord) -> bool {
     const float tau_v = s.density.tau_v[cell];
@@ -210,7 +215,7 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchM
               if (s.diffuse_light[b]) {
                 local[b] += sample_field(g, s.diffuse_light[b], pos, mode.trilinear);
                 peak[b] += s.diffuse.peak(b, s.albedo[b] * tau_sample * s.extinction_ratio[b],
-                                          s.diffuse.zonal_weight(pos, to_eye)) *
+                                          zonal_weight(pos)) *
                            step / fmaxf(chord, 1e-30f);
               }
         }
@@ -222,7 +227,7 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchM
         if (b < s.n_bands) source[b] = s.voxel_source[b][cell];
       if constexpr (kDiffuse) {
         if (tau_v > 0.0f) {
-          const float w = s.diffuse.zonal_weight(origin + (t + 0.5f * chord) * dir, to_eye);
+          const float w = zonal_weight(origin + (t + 0.5f * chord) * dir);
           NEBULA_UNROLL
           for (int b = 0; b < kMaxBands; ++b)
             if (b < s.n_bands && s.diffuse.has[b])
@@ -243,7 +248,7 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchM
         if (tau_v > 0.0f) {
           // The zonal response's weight (0 without zonal degrees): its peak
           // blends with the harmonics' own as the per-view light did.
-          const float w = s.diffuse.zonal_weight(origin + (t + 0.5f * chord) * dir, to_eye);
+          const float w = zonal_weight(origin + (t + 0.5f * chord) * dir);
           NEBULA_UNROLL
           for (int b = 0; b < kMaxBands; ++b)
             if (b < s.n_bands && s.diffuse_light[b]) {
@@ -271,20 +276,29 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchM
   return out;
 }
 
-// Calls f(smooth, diffuse, voxel_sources) with std::bool_constant values: the one place that
-// turns the scene's mode into march_ray's template arguments, for the CPU loop
+// Calls f(std::true_type) when the scene's field has zonal degrees, else
+// f(std::false_type): the one place that makes it a template argument.
+template <class F>
+decltype(auto) dispatch_zonal(const MarchScene& s, F&& f) {
+  if (s.has_diffuse && s.diffuse.zonal > 0) return f(std::true_type{});
+  return f(std::false_type{});
+}
+
+// Calls f(smooth, diffuse, voxel_sources, zonal) with std::bool_constant values: the one place
+// that turns the scene's mode into march_ray's template arguments, for the CPU loop
 // and the CUDA launch. The exact traversal, the smooth mode and the diffuse
-// field's terms are compiled apart, so the reference path carries none of the
-// others' code (registers, branches). The preview's voxel sources go with
-// the exact traversal.
+// field's terms (with or without zonal degrees) are compiled apart, so the
+// reference path carries none of the others' code (registers, branches). The
+// preview's voxel sources go with the exact traversal.
 template <class F>
 decltype(auto) dispatch_march(const MarchScene& s, MarchMode mode, F&& f) {
-  auto with_smooth = [&](auto diffuse) -> decltype(auto) {
-    if (mode.voxel_sources) return f(std::false_type{}, diffuse, std::true_type{});
-    return mode.step_voxels > 0.0f ? f(std::true_type{}, diffuse, std::false_type{})
-                                   : f(std::false_type{}, diffuse, std::false_type{});
+  auto with_smooth = [&](auto diffuse, auto zonal) -> decltype(auto) {
+    if (mode.voxel_sources) return f(std::false_type{}, diffuse, std::true_type{}, zonal);
+    return mode.step_voxels > 0.0f ? f(std::true_type{}, diffuse, std::false_type{}, zonal)
+                                   : f(std::false_type{}, diffuse, std::false_type{}, zonal);
   };
-  return s.has_diffuse ? with_smooth(std::true_type{}) : with_smooth(std::false_type{});
+  if (!s.has_diffuse) return with_smooth(std::false_type{}, std::false_type{});
+  return dispatch_zonal(s, [&](auto zonal) -> decltype(auto) { return with_smooth(std::true_type{}, zonal); });
 }
 
 }  // namespace nebula

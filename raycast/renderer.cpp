@@ -90,14 +90,14 @@ Image render_cpu(const RenderInputs& in, RenderStats* stats) {
       });
     });
   }
-  dispatch_march(scene, in.mode, [&](auto smooth, auto diffuse, auto voxel_sources) {
+  dispatch_march(scene, in.mode, [&](auto smooth, auto diffuse, auto voxel_sources, auto zonal) {
     tbb::parallel_for(tbb::blocked_range<int>(0, in.camera.height), [&](const auto& rows) {
       uint64_t local_clamps = 0;
       for (int y = rows.begin(); y != rows.end(); ++y)
         for (int x = 0; x < in.camera.width; ++x) {
           Vec3 origin, dir;
           if (!in.camera.ray(x, y, origin, dir)) continue;
-          const RayResult r = march_ray<smooth(), diffuse(), voxel_sources()>(scene, origin, dir, in.mode);
+          const RayResult r = march_ray<smooth(), diffuse(), voxel_sources(), zonal()>(scene, origin, dir, in.mode);
           store_radiance(r, scene.n_bands, in.exposure, image.pixels.data(), image.width, image.height, x, y);
           local_clamps += r.table_clamps;
         }

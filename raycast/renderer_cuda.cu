@@ -54,7 +54,7 @@ __global__ void voxel_source_kernel(MarchScene scene, Camera camera, VoxelSource
   if (n) atomicAdd(clamps, static_cast<unsigned long long>(n));
 }
 
-template <bool kSmooth, bool kDiffuse, bool kVoxelSources>
+template <bool kSmooth, bool kDiffuse, bool kVoxelSources, bool kZonal>
 __global__ void __launch_bounds__(256, kSmooth ? 2 : NEBULA_RENDER_MIN_BLOCKS)
     render_kernel(MarchScene scene, Camera camera, MarchMode mode, float exposure, float* pixels,
                   unsigned long long* clamps) {
@@ -63,7 +63,7 @@ __global__ void __launch_bounds__(256, kSmooth ? 2 : NEBULA_RENDER_MIN_BLOCKS)
   if (x >= camera.width || y >= camera.height) return;
   Vec3 origin, dir;
   if (!camera.ray(x, y, origin, dir)) return;
-  const RayResult r = march_ray<kSmooth, kDiffuse, kVoxelSources>(scene, origin, dir, mode);
+  const RayResult r = march_ray<kSmooth, kDiffuse, kVoxelSources, kZonal>(scene, origin, dir, mode);
   store_radiance(r, scene.n_bands, exposure, pixels, camera.width, camera.height, x, y);
   if (r.table_clamps) atomicAdd(clamps, static_cast<unsigned long long>(r.table_clamps));
 }
@@ -146,8 +146,8 @@ double render_cuda_to_device(const RenderInputs& in, float* pixels, unsigned lon
     NEBULA_CUDA_CHECK(cudaGetLastError());
   }
   // One kernel per mode (raycast/ray_march.h, dispatch_march).
-  dispatch_march(scene, in.mode, [&](auto smooth, auto diffuse, auto voxel_sources) {
-    render_kernel<smooth(), diffuse(), voxel_sources()>
+  dispatch_march(scene, in.mode, [&](auto smooth, auto diffuse, auto voxel_sources, auto zonal) {
+    render_kernel<smooth(), diffuse(), voxel_sources(), zonal()>
         <<<grid, block>>>(scene, in.camera, in.mode, in.exposure, pixels, clamps);
   });
   NEBULA_CUDA_CHECK(cudaGetLastError());

@@ -335,7 +335,7 @@ int run(const Args& args) {
   DisplaySettings gpu_display;
   double gpu_exposure = -1, gpu_ms = 0;
   uint64_t gpu_version = 0;
-  bool gpu_shown = false;
+  bool gpu_shown = false, gpu_preview = false;  // gpu_preview: the shown GPU frame is a moving camera's
   std::optional<Frame> full;  // the last full-resolution frame of the current view
   std::optional<Frame> shown;
   Rgba8 shown_rgba;
@@ -450,8 +450,11 @@ int run(const Args& args) {
       const double exposure = view.display.auto_exposure && shown_rgba.exposure > 0 ? shown_rgba.exposure : view.camera.exposure;
       CameraSettings c = view.camera;
       c.exposure = 1;
+      // A moving camera's GPU frames are previews too (each voxel's light once per view, at full
+      // size); the exact frame follows when the camera rests.
+      const bool want_preview = moving && !args.exact_preview;
       if (!gpu_shown || !same_view(c, gpu_camera) || !(gpu_display == view.display) || gpu_exposure != exposure ||
-          gpu_version != status.version) {
+          gpu_version != status.version || gpu_preview != want_preview) {
         const size_t bytes = size_t(c.width) * c.height * 4;
         if (pbo == 0) glGenBuffers(1, &pbo);
         glBindBuffer(GL_PIXEL_UNPACK_BUFFER, pbo);
@@ -464,7 +467,9 @@ int run(const Args& args) {
           RenderInputs in = prepared->inputs;
           in.camera = make_camera(c);
           in.exposure = 1.0f;
+          in.mode.voxel_sources = want_preview;
           gpu_ms = 1e3 * gpu->render_to_gl(in, exposure, view.display, pbo);
+          gpu_preview = want_preview;
           if (texture.id == 0) glGenTextures(1, &texture.id);
           glBindTexture(GL_TEXTURE_2D, texture.id);
           glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
@@ -540,8 +545,8 @@ int run(const Args& args) {
       ImGui::Begin("nebula-view");
       ImGui::Text("%s on the %s", session.source().name().c_str(), backend == Backend::Cuda ? "GPU (CUDA)" : "CPU");
       if (gpu_shown)
-        ImGui::Text("GPU frame %.2f ms (%dx%d, CUDA-OpenGL interop); host frame %.1f ms", gpu_ms, texture.width,
-                    texture.height, status.frame_seconds * 1e3);
+        ImGui::Text("GPU frame %.2f ms (%dx%d, CUDA-OpenGL interop%s); host frame %.1f ms", gpu_ms, texture.width,
+                    texture.height, gpu_preview ? ", moving: voxel sources" : "", status.frame_seconds * 1e3);
       else
         ImGui::Text("frame %.1f ms (%dx%d)%s", status.frame_seconds * 1e3, shown ? shown->camera.width : 0,
                     shown ? shown->camera.height : 0, moving ? ", moving: reduced size" : "");
@@ -899,8 +904,8 @@ int main(int argc, char** argv) {
   app.add_option("--window-height", a.window_height, "window height")->capture_default_str();
   app.add_option("--preview-scale", a.preview_scale, "while moving, render at 1/N of the size (default: 2 CPU, 1 GPU)");
   app.add_flag("--exact-preview", a.exact_preview,
-               "march the moving camera's reduced frames exactly too (default: each voxel's light taken once per "
-               "view, about 4x faster on the CPU; docs/marcher.md)");
+               "march the moving camera's frames exactly too (default: each voxel's light taken once per view, "
+               "about 4x faster on the CPU and 1.5x on the GPU; docs/marcher.md)");
   app.add_option("--preview-coarsening", a.preview_coarsening,
                  "while moving, render from the grid halved N times, baked on its own (default: 1 on the CPU, 0 on "
                  "the GPU)")
