@@ -84,7 +84,7 @@ const std::initializer_list<std::string_view> kProceduralKeys = {
     "far_transition", "noise_amplitude", "noise_frequency", "noise_octaves", "noise_gain",
     "noise_lacunarity", "far_offset", "far_warp", "filament_amplitude", "filament_frequency",
     "filament_octaves", "filament_sharpness", "edge_fade"};
-const std::initializer_list<std::string_view> kEmissionKeys = {"file", "prefix"};
+const std::initializer_list<std::string_view> kEmissionKeys = {"file", "prefix", "scale"};
 const std::initializer_list<std::string_view> kDustKeys = {"albedo", "g", "R_V", "law", "tables"};
 const std::initializer_list<std::string_view> kStarKeys = {"name", "position", "luminosity_lsun",
                                                            "temperature_K", "class"};
@@ -107,6 +107,7 @@ struct DensityPlan {
 
 struct EmissionPlan {
   std::string path, prefix = "emission_";
+  double scale = 1;  // multiplies every band's emission (the viewer's emission slider)
 };
 
 class Parser {
@@ -654,6 +655,11 @@ std::optional<EmissionPlan> Parser::parse_emission(const toml::table& root) cons
   const toml::table& t = table_at(*n, "emission");
   known_keys(t, "emission", kEmissionKeys);
   EmissionPlan plan;
+  if (const toml::node* v = t.get("scale")) {
+    plan.scale = number(*v, "emission.scale");
+    if (!(plan.scale >= 0) || !std::isfinite(plan.scale))
+      fail("emission.scale", "is " + number_text(plan.scale) + "; must be >= 0 and finite");
+  }
   const toml::node* file = t.get("file");
   if (file == nullptr) fail("emission.file", "missing required key (an HDF5 file)");
   plan.path = data_path(*file, "emission.file");
@@ -860,6 +866,13 @@ void Parser::load_grids(const DensityPlan& density, const std::optional<Emission
     } catch (const Error& e) {
       fail("emission.file", e.what());
     }
+    scene.emission_scale = emission->scale;
+    if (emission->scale != 1)
+      for (std::vector<float>& plane : scene.emission)
+        for (float& v : plane) {
+          v = static_cast<float>(v * emission->scale);
+          if (!std::isfinite(v)) fail("emission.scale", "makes an emission value overflow a float (inf)");
+        }
   }
 }
 

@@ -160,6 +160,14 @@ star_psf_pixels = 2.0
   EXPECT_EQ(s.density.tau_v[0], 0.5f);  // 0.25 x scale 2
   ASSERT_EQ(s.emission.size(), 3u);
   EXPECT_EQ(s.emission[0][5], 2.5f);
+  // emission.scale multiplies every band's emission (and only the emission).
+  std::string scaled = text;
+  scaled.replace(scaled.find("prefix = \"glow_\""), 16, "prefix = \"glow_\"\nscale = 0.25");
+  const Scene q = load_scene(write_text("scaled.toml", scaled));
+  ASSERT_EQ(q.emission.size(), 3u);
+  EXPECT_EQ(q.emission[0][5], 0.625f);
+  EXPECT_EQ(q.emission[0][4], 0.0f);
+  EXPECT_EQ(q.density.tau_v, s.density.tau_v);
   EXPECT_EQ(s.dust.albedo, (std::vector<double>{0.7, 0.6, 0.5}));
   EXPECT_EQ(s.dust.g, (std::vector<double>{0.65, 0.55, 0.5}));
   EXPECT_EQ(s.dust.R_V, 3.1);
@@ -222,7 +230,8 @@ TEST_F(SceneFile, RefusesUnknownKeysAtEveryLevel) {
   refused("band_key", edited("albedo = 0.6", "albedo = { B = 0.6, V = 0.6, R = 0.6, U = 0.5 }"),
           {"dust.albedo.U", "unknown band"});
   refused("tables_key", edited("R_V = 5.0", "R_V = 5.0\ntables = { I = \"t.h5\" }"), {"dust.tables.I", "unknown band"});
-  refused("emission_key", std::string("[emission]\nfile = \"e.h5\"\nscale = 2\n") + kBase, {"emission.scale", "unknown key"});
+  refused("emission_key", std::string("[emission]\nfile = \"e.h5\"\ngain = 2\n") + kBase, {"emission.gain", "unknown key"});
+  refused("emission_scale", std::string("[emission]\nfile = \"e.h5\"\nscale = -1\n") + kBase, {"emission.scale", ">= 0"});
 }
 
 TEST_F(SceneFile, RefusesWrongTypes) {

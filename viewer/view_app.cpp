@@ -636,6 +636,21 @@ int run(const Args& args) {
             if (o.rfind("density.scale=", 0) == 0) current = std::strtod(o.c_str() + 14, nullptr);
           edit("density.scale", toml_number(current * scale));
         }
+        // The emission's scale: [emission]'s for a grid, the map's own for an axial scene.
+        if (!scene.emission.empty() || scene.axial) {
+          const std::string key = scene.axial ? "axial.emission_scale" : "emission.scale";
+          float emission = 1;
+          ImGui::Text("emission: multiply by");
+          ImGui::SameLine();
+          if (ImGui::Button("x0.5##emission")) emission = 0.5f;
+          ImGui::SameLine();
+          if (ImGui::Button("x2##emission")) emission = 2.0f;
+          ImGui::SameLine();
+          const bool reset = ImGui::Button("= 1##emission");
+          const double current = scene.axial ? scene.axial->emission_scale : scene.emission_scale;
+          if (reset) edit(key, toml_number(1.0));
+          else if (emission != 1) edit(key, toml_number(current * emission));
+        }
       }
       if (ImGui::CollapsingHeader("Stars", ImGuiTreeNodeFlags_DefaultOpen)) {
         for (size_t i = 0; i < scene.stars.size(); ++i) {
