@@ -160,6 +160,7 @@ struct Scene {
   // radiance j a ray gains crossing the voxel along one voxel edge
   // (L_sun pc^-2 sr^-1; DESIGN.md section 3).
   std::vector<std::vector<float>> emission;
+  double density_scale = 1.0;   // [density] scale, already applied to `density`
   double emission_scale = 1.0;  // [emission] scale, already applied to `emission`
   DustParams dust;
   std::vector<SceneStar> stars;

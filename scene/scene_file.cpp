@@ -846,6 +846,7 @@ void Parser::load_grids(const DensityPlan& density, const std::optional<Emission
   } catch (const Error& e) {
     fail(density.key, e.what());
   }
+  scene.density_scale = density.scale;
   if (density.scale != 1) {
     for (float& v : scene.density.tau_v) v = static_cast<float>(v * density.scale);
     try {

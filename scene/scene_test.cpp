@@ -158,6 +158,7 @@ star_psf_pixels = 2.0
   EXPECT_EQ(s.density.shape.nx, 4);
   EXPECT_EQ(s.density.shape.nz, 2);
   EXPECT_EQ(s.density.tau_v[0], 0.5f);  // 0.25 x scale 2
+  EXPECT_EQ(s.density_scale, 2.0);
   ASSERT_EQ(s.emission.size(), 3u);
   EXPECT_EQ(s.emission[0][5], 2.5f);
   // emission.scale multiplies every band's emission (and only the emission).
@@ -168,6 +169,8 @@ star_psf_pixels = 2.0
   EXPECT_EQ(q.emission[0][5], 0.625f);
   EXPECT_EQ(q.emission[0][4], 0.0f);
   EXPECT_EQ(q.density.tau_v, s.density.tau_v);
+  EXPECT_EQ(q.emission_scale, 0.25);
+  EXPECT_EQ(s.emission_scale, 1.0);
   EXPECT_EQ(s.dust.albedo, (std::vector<double>{0.7, 0.6, 0.5}));
   EXPECT_EQ(s.dust.g, (std::vector<double>{0.65, 0.55, 0.5}));
   EXPECT_EQ(s.dust.R_V, 3.1);

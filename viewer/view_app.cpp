@@ -624,32 +624,29 @@ int run(const Args& args) {
         int law = scene.dust.law == ExtinctionLaw::CCM89 ? 0 : 1;
         const char* laws[] = {"ccm89", "odonnell94"};
         if (ImGui::Combo("extinction law", &law, laws, 2)) edit("dust.law", std::string("\"") + laws[law] + "\"");
-        float scale = 1;
-        ImGui::Text("density: multiply by");
-        ImGui::SameLine();
-        if (ImGui::Button("x0.5")) scale = 0.5f;
-        ImGui::SameLine();
-        if (ImGui::Button("x2")) scale = 2.0f;
-        if (scale != 1) {
-          double current = 1;
-          for (const std::string& o : session.source().overrides())
-            if (o.rfind("density.scale=", 0) == 0) current = std::strtod(o.c_str() + 14, nullptr);
-          edit("density.scale", toml_number(current * scale));
-        }
+        // "WHAT: multiply by x0.5 x2 (= 1)": the factor clicked, 0 for "= 1", 1 for none.
+        auto scale_buttons = [](const std::string& what, bool with_reset) {
+          float factor = 1;
+          ImGui::Text("%s: multiply by", what.c_str());
+          ImGui::SameLine();
+          if (ImGui::Button(("x0.5##" + what).c_str())) factor = 0.5f;
+          ImGui::SameLine();
+          if (ImGui::Button(("x2##" + what).c_str())) factor = 2.0f;
+          if (with_reset) {
+            ImGui::SameLine();
+            if (ImGui::Button(("= 1##" + what).c_str())) factor = 0.0f;
+          }
+          return factor;
+        };
+        const float scale = scale_buttons("density", false);
+        if (scale != 1) edit("density.scale", toml_number(scene.density_scale * scale));
         // The emission's scale: [emission]'s for a grid, the map's own for an axial scene.
         if (!scene.emission.empty() || scene.axial) {
           const std::string key = scene.axial ? "axial.emission_scale" : "emission.scale";
-          float emission = 1;
-          ImGui::Text("emission: multiply by");
-          ImGui::SameLine();
-          if (ImGui::Button("x0.5##emission")) emission = 0.5f;
-          ImGui::SameLine();
-          if (ImGui::Button("x2##emission")) emission = 2.0f;
-          ImGui::SameLine();
-          const bool reset = ImGui::Button("= 1##emission");
+          const float factor = scale_buttons("emission", true);
           const double current = scene.axial ? scene.axial->emission_scale : scene.emission_scale;
-          if (reset) edit(key, toml_number(1.0));
-          else if (emission != 1) edit(key, toml_number(current * emission));
+          if (factor == 0) edit(key, toml_number(1.0));
+          else if (factor != 1) edit(key, toml_number(current * factor));
         }
       }
       if (ImGui::CollapsingHeader("Stars", ImGuiTreeNodeFlags_DefaultOpen)) {
