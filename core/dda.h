@@ -50,7 +50,16 @@ NEBULA_HD bool clip_to_grid(const GridShape& g, Vec3 a, Vec3 dir, float len, flo
 // coordinates: visit(x, y, z, voxel_index, length). Callers that need the
 // voxel's position use these instead of dividing the index (64-bit integer
 // division is slow on a GPU).
-template <class Visit>
+//
+// Where the walk keeps its per-axis state (the voxel and the next crossing on
+// each axis): in named scalars, registers on the GPU, or in arrays indexed by
+// the axis chosen at run time, local memory on the GPU (loads and stores
+// through the caches per voxel crossed). Registers are faster for the star
+// bakes, photon passes, path tracer and spectral march (docs/performance.md,
+// "The voxel walk"); the band marcher's kernel, held to 64 registers for
+// occupancy, is faster with the arrays (the registers would spill).
+enum class WalkState { Registers, Arrays };
+template <WalkState kState = WalkState::Registers, class Visit>
 NEBULA_HD void traverse_segment_cells(const GridShape& g, Vec3 a, Vec3 b, Visit&& visit) {
   const Vec3 d = b - a;
   const float len = length(d);
@@ -88,20 +97,49 @@ NEBULA_HD void traverse_segment_cells(const GridShape& g, Vec3 a, Vec3 b, Visit&
       t_delta[k] = FLT_MAX;
     }
   }
-  float t = t0;
-  for (int guard = n[0] + n[1] + n[2] + 3; guard > 0; --guard) {
-    const int k = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
-    const float t_next = fminf(fmaxf(t_max[k], t), t1);
+  auto visit_cell = [&](int x, int y, int z, float chord) -> bool {
     if constexpr (std::is_same_v<decltype(visit(0, 0, 0, size_t(0), 0.0f)), bool>) {
-      if (!visit(cell[0], cell[1], cell[2], g.index(cell[0], cell[1], cell[2]), t_next - t)) return;
+      return visit(x, y, z, g.index(x, y, z), chord);
     } else {
-      visit(cell[0], cell[1], cell[2], g.index(cell[0], cell[1], cell[2]), t_next - t);
+      visit(x, y, z, g.index(x, y, z), chord);
+      return true;
     }
-    t = t_next;
-    if (t >= t1) return;
-    cell[k] += step[k];
-    if (cell[k] < 0 || cell[k] >= n[k]) return;
-    t_max[k] += t_delta[k];
+  };
+  float t = t0;
+  if constexpr (kState == WalkState::Registers) {
+    int cx = cell[0], cy = cell[1], cz = cell[2];
+    float tx = t_max[0], ty = t_max[1], tz = t_max[2];
+    for (int guard = n[0] + n[1] + n[2] + 3; guard > 0; --guard) {
+      const int k = tx < ty ? (tx < tz ? 0 : 2) : (ty < tz ? 1 : 2);
+      const float t_next = fminf(fmaxf(k == 0 ? tx : (k == 1 ? ty : tz), t), t1);
+      if (!visit_cell(cx, cy, cz, t_next - t)) return;
+      t = t_next;
+      if (t >= t1) return;
+      if (k == 0) {
+        cx += step[0];
+        if (cx < 0 || cx >= n[0]) return;
+        tx += t_delta[0];
+      } else if (k == 1) {
+        cy += step[1];
+        if (cy < 0 || cy >= n[1]) return;
+        ty += t_delta[1];
+      } else {
+        cz += step[2];
+        if (cz < 0 || cz >= n[2]) return;
+        tz += t_delta[2];
+      }
+    }
+  } else {
+    for (int guard = n[0] + n[1] + n[2] + 3; guard > 0; --guard) {
+      const int k = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
+      const float t_next = fminf(fmaxf(t_max[k], t), t1);
+      if (!visit_cell(cell[0], cell[1], cell[2], t_next - t)) return;
+      t = t_next;
+      if (t >= t1) return;
+      cell[k] += step[k];
+      if (cell[k] < 0 || cell[k] >= n[k]) return;
+      t_max[k] += t_delta[k];
+    }
   }
 }
 

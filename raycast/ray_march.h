@@ -182,7 +182,9 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchM
   // The zonal response's weight at p (0 without zonal degrees, at compile time).
   auto zonal_weight = [&](Vec3 p) { return kZonal ? s.diffuse.zonal_weight(p, to_eye) : 0.0f; };
   float t = t_enter;  // where the current voxel begins along the ray
-  traverse_segment_cells(g, origin, origin + far * dir, [&](int, int, int, size_t cell, float chord) -> bool {
+  // The walk's state in arrays: this kernel is held to 64 registers (core/dda.h).
+  traverse_segment_cells<WalkState::Arrays>(g, origin, origin + far * dir,
+                                            [&](int, int, int, size_t cell, float chord) -> bool {
     const float tau_v = s.density.tau_v[cell];
     float source[kMaxBands] = {};
     float peak[kMaxBands] = {};  // the diffuse response's forward peak (kDiffuse)
