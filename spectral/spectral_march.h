@@ -97,22 +97,71 @@ NEBULA_HD float hg_phase(float mu, float g) {
   return (1.0f - g * g) * kInv4Pi / (d * sqrtf(d));
 }
 
+// Calls f(i) for i = 0 .. n - 1. kBound > 0 is a compile-time bound on n: the
+// loop unrolls and i is a constant in each copy (the point of RayAccumulators).
+template <int kBound, class F>
+NEBULA_HD void for_each_index(int n, F&& f) {
+  if constexpr (kBound > 0) {
+    NEBULA_UNROLL
+    for (int i = 0; i < kBound; ++i)
+      if (i < n) f(i);
+  } else {
+    for (int i = 0; i < n; ++i) f(i);
+  }
+}
+
+// A ray's accumulators acc(row, col), stored at image plane row * cols + col:
+// the row is the star (Projection) or 0, the column the basis element
+// (Projection, LightBasis) or the filter (Double, Analytic, VoxelLight);
+// kBasis bounds the basis size where it is not the column (VoxelLight).
+// Positive bounds make every loop over them unroll, so every index is a
+// constant and the GPU keeps the accumulators in registers: an array indexed
+// at run time lives in local memory, a read-modify-write through the caches
+// per accumulator and voxel. 0: run-time extents within kMaxAccumulators (the
+// CPU's choice, and the GPU's beyond its buckets, spectral_renderer_cuda.cu).
+template <int kRowBound, int kColBound, int kBasisBound>
+struct RayAccumulators {
+  static constexpr int kRows = kRowBound, kCols = kColBound, kBasis = kBasisBound;
+  static constexpr bool kFixed = kRows > 0 && kCols > 0;
+  float v[kFixed ? kRows * kCols : kMaxAccumulators];
+  int cols = 0;  // the run-time columns
+  NEBULA_HD float& operator()(int row, int col) { return v[row * (kFixed ? kCols : cols) + col]; }
+};
+using DynamicAccumulators = RayAccumulators<0, 0, 0>;
+
+// The accumulators' run-time rows and columns for a method (their product is n_acc).
+NEBULA_HD int accumulator_rows(const SpectralSceneView& s) {
+  return s.method == SpectralMethod::Projection ? s.n_stars : 1;
+}
+NEBULA_HD int accumulator_cols(const SpectralSceneView& s) {
+  return s.method == SpectralMethod::Projection || s.method == SpectralMethod::LightBasis ? s.n_basis : s.n_acc;
+}
+
+// acc(row, col) into out[(row * cols + col) * stride] (an image's planes).
+template <class Acc>
+NEBULA_HD void store_accumulators(const SpectralSceneView& s, Acc& acc, float* out, size_t stride) {
+  const int cols = accumulator_cols(s);
+  for_each_index<Acc::kRows>(accumulator_rows(s), [&](int r) {
+    for_each_index<Acc::kCols>(cols, [&](int c) { out[size_t(r * cols + c) * stride] = acc(r, c); });
+  });
+}
+
 // Adds w times the pair's light in every accumulator (the method a template
 // argument, so each kernel holds only its own code).
-template <SpectralMethod kMethod>
-NEBULA_HD void add_pair(const SpectralSceneView& s, int star, float w, float D, float* acc) {
+template <SpectralMethod kMethod, class Acc>
+NEBULA_HD void add_pair(const SpectralSceneView& s, int star, float w, float D, Acc& acc) {
   switch (kMethod) {
     case SpectralMethod::Double: {
       const float* q = s.q + size_t(star) * s.n_acc * s.n_lambda;
       for (int i = 0; i < s.n_lambda; ++i) {
         const float e = w * expf(-s.kappa[i] * D);
-        for (int f = 0; f < s.n_acc; ++f) acc[f] += q[f * s.n_lambda + i] * e;
+        for_each_index<Acc::kCols>(s.n_acc, [&](int f) { acc(0, f) += q[f * s.n_lambda + i] * e; });
       }
       break;
     }
     case SpectralMethod::Analytic: {
       const double a = s.C_T * double(D);
-      for (int f = 0; f < s.n_acc; ++f) {
+      for_each_index<Acc::kCols>(s.n_acc, [&](int f) {
         const size_t pf = size_t(star) * s.n_acc + f;
         const double* b = s.breaks + pf * (s.segments + 1);
         const double* c = s.coefficients + pf * s.segments * (s.degree + 1);
@@ -122,8 +171,8 @@ NEBULA_HD void add_pair(const SpectralSceneView& s, int star, float w, float D, 
             const double ck = c[seg * (s.degree + 1) + k];
             if (ck != 0.0) sum += ck * power_exp_integral(k - 1, a, b[seg], b[seg + 1]);
           }
-        acc[f] += w * float(s.C_T * sum);
-      }
+        acc(0, f) += w * float(s.C_T * sum);
+      });
       break;
     }
     case SpectralMethod::VoxelLight:
@@ -135,10 +184,9 @@ NEBULA_HD void add_pair(const SpectralSceneView& s, int star, float w, float D, 
       const int d0 = int(x);
       const float fd = x - float(d0);
       const int N = s.n_basis;
-      float* out = s.method == SpectralMethod::Projection ? acc + star * N : acc;
-      if (s.method == SpectralMethod::Projection) {
+      if constexpr (kMethod == SpectralMethod::Projection) {
         const float* c0 = s.coeff + size_t(d0) * N;
-        for (int j = 0; j < N; ++j) out[j] += w * (c0[j] + fd * (c0[N + j] - c0[j]));
+        for_each_index<Acc::kCols>(N, [&](int j) { acc(star, j) += w * (c0[j] + fd * (c0[N + j] - c0[j])); });
       } else {
         const float u = s.stars[star].temperature_u;
         const int t_last = s.n_temperature > 1 ? s.n_temperature - 2 : 0;
@@ -146,25 +194,27 @@ NEBULA_HD void add_pair(const SpectralSceneView& s, int star, float w, float D, 
         const float ft = s.n_temperature > 1 ? u - float(t0) : 0.0f;
         const float* c00 = s.coeff + (size_t(t0) * s.n_depth + d0) * N;
         const float* c10 = s.n_temperature > 1 ? c00 + size_t(s.n_depth) * N : c00;
-        for (int j = 0; j < N; ++j) {
+        for_each_index<Acc::kCols>(N, [&](int j) {
           const float lo = c00[j] + fd * (c00[N + j] - c00[j]);
           const float hi = c10[j] + fd * (c10[N + j] - c10[j]);
-          out[j] += w * (lo + ft * (hi - lo));
-        }
+          acc(0, j) += w * (lo + ft * (hi - lo));
+        });
       }
       break;
     }
   }
 }
 
-// VoxelLight: the coefficients of the table at depth D (false beyond it).
+// VoxelLight: the coefficients of the table at depth D (false beyond it);
+// kWidth > 0 bounds width at compile time (RayAccumulators).
+template <int kWidth = 0>
 NEBULA_HD bool depth_coefficients(const SpectralSceneView& s, const float* table, int width, float D, float* out) {
   const float x = D / s.depth_step;
   if (!(x < float(s.n_depth - 1))) return false;
   const int d0 = int(x);
   const float fd = x - float(d0);
   const float* c0 = table + size_t(d0) * width;
-  for (int i = 0; i < width; ++i) out[i] = c0[i] + fd * (c0[width + i] - c0[i]);
+  for_each_index<kWidth>(width, [&](int i) { out[i] = c0[i] + fd * (c0[width + i] - c0[i]); });
   return true;
 }
 
@@ -178,17 +228,72 @@ NEBULA_HD const float* star_integrals(const SpectralSceneView& s, int k, size_t 
   return s.star_coeff + (size_t(k) * s.n_depth + d0) * (s.n_acc * s.n_basis);
 }
 
-// u[4][FN] += (w, grad) times the star's row q interpolated at fd (restrict:
-// the table and the voxel's light never overlap, so the loop vectorises). The
-// same sums, in the same order, as the GPU's per-output loop below.
-NEBULA_HD void add_star_light(float* __restrict__ u, const float* __restrict__ q, int FN, float fd, float w, Vec3 grad) {
-  for (int i = 0; i < FN; ++i) {
+// u[c * stride + i] += (w, grad)[c] times the star's row q interpolated at fd,
+// for c = 0 .. 3 and i < FN (restrict: the table and the voxel's light never
+// overlap, so the CPU's loop vectorises; kFN > 0 bounds FN for the GPU's
+// register sums, whose stride is kFN).
+template <int kFN = 0>
+NEBULA_HD void add_star_light(float* __restrict__ u, int stride, const float* __restrict__ q, int FN, float fd,
+                              float w, Vec3 grad) {
+  for_each_index<kFN>(FN, [&](int i) {
     const float v = q[i] + fd * (q[FN + i] - q[i]);
     u[i] += w * v;
-    u[FN + i] += grad.x * v;
-    u[2 * FN + i] += grad.y * v;
-    u[3 * FN + i] += grad.z * v;
-  }
+    u[stride + i] += grad.x * v;
+    u[2 * stride + i] += grad.y * v;
+    u[3 * stride + i] += grad.z * v;
+  });
+}
+
+// VoxelLight: one voxel-star pair of the pre-pass, for a voxel at `centre`
+// (e its direction to the eye, inv_rho 1 / its distance from the eye or 0,
+// tau its V-band depth) and star k at V-band depth `depth` from it: the
+// weight w = a tau_V L/(4 pi r^2) p_HG(mu) (0 where the pair is not summed:
+// an empty voxel, a near pair, beyond the table), its gradient, the star
+// table's depth coordinate x and near = 1 where the march takes the pair
+// exactly. Branch-free: arithmetic and 0/1 masks, so that the CPU's rows of
+// voxels vectorise.
+struct VoxelStarPair {
+  float w, gx, gy, gz, x, near;
+};
+NEBULA_HD VoxelStarPair voxel_star_pair(const SpectralSceneView& s, const Camera& camera, Vec3 centre, Vec3 e,
+                                        float inv_rho, float tau, int k, float depth) {
+  const float near2 = 0.5f * s.near_distance * s.near_distance, g2 = s.g * s.g;
+  const float phase_norm = (1.0f - g2) * kInv4Pi * s.albedo;
+  const Vec3 star = s.stars[k].position;
+  const float power = s.stars[k].power * kInv4Pi * phase_norm;
+  const float dx = centre.x - star.x, dy = centre.y - star.y, dz = centre.z - star.z;
+  const float r2 = dx * dx + dy * dy + dz * dz;
+  const float inv_r = 1.0f / sqrtf(r2 + 1e-30f);
+  const float hx = dx * inv_r, hy = dy * inv_r, hz = dz * inv_r;
+  const float mu = hx * e.x + hy * e.y + hz * e.z;
+  // The expansion's error is second order, (offset / r)^2 times the curvature of ln w
+  // in the angle seen from the star: 2 for 1/r^2, plus the phase's |d^2 ln p / d theta^2|
+  // (3g / (1 - g)^2 in forward scattering: 11 at g = 0.6). near_distance holds for
+  // the curvature 2 of 1/r^2 alone; a sharper phase widens it as the square root.
+  const float A = 1.0f + g2 - 2.0f * s.g * mu, inv_A = 1.0f / A;
+  const float curvature = 2.0f + fabsf(3.0f * s.g * (mu * A - 2.0f * s.g * (1.0f - mu * mu))) * inv_A * inv_A;
+  const float lit = tau > 0.0f ? 1.0f : 0.0f;
+  const float close = r2 < near2 * curvature ? lit : 0.0f;
+  const float x = depth / s.depth_step;
+  // Products of 0/1 flags, not &&: no branch (beyond the table: below the transmittance cut).
+  const float take = (lit - close) * (x < float(s.n_depth - 1) ? 1.0f : 0.0f);
+  // r^2 softened by the pixel's footprint at the star, as chord_irradiance does (a ray
+  // stands for its pixel): 1 / (r^2 + w^2 / (4 pi)).
+  const float t_star =
+      (camera.position.x - star.x) * e.x + (camera.position.y - star.y) * e.y + (camera.position.z - star.z) * e.z;
+  const float width = s.footprint.width_at_eye + 0.5f * (t_star + fabsf(t_star)) * s.footprint.spread;
+  const float inv_r2 = 1.0f / (r2 + width * width * kInv4Pi);
+  const float wi = power * tau * inv_r2 * inv_A * sqrtf(inv_A) * take;
+  // grad ln w = -2 d / r2 + (d ln p / d mu) grad mu, grad mu = (e - mu h) / r - (h - mu e) / rho.
+  const float a = -2.0f * inv_r2, b = 3.0f * s.g * inv_A;
+  VoxelStarPair out;
+  out.gx = wi * (a * dx + b * (inv_r * (e.x - mu * hx) - inv_rho * (hx - mu * e.x)));
+  out.gy = wi * (a * dy + b * (inv_r * (e.y - mu * hy) - inv_rho * (hy - mu * e.y)));
+  out.gz = wi * (a * dz + b * (inv_r * (e.z - mu * hz) - inv_rho * (hz - mu * e.z)));
+  out.w = wi;
+  out.x = x * take;
+  out.near = close;
+  return out;
 }
 
 // VoxelLight's per-view pre-pass for voxels x0 .. x0 + kRow - 1 (those below
@@ -197,12 +302,12 @@ NEBULA_HD void add_star_light(float* __restrict__ u, const float* __restrict__ q
 // mu, with the direction to the eye varying across the voxel as the rays
 // through it do), into light[cell][4][F N]; near[cell] bit k: star k's pair
 // taken exactly in the march instead. Cost: voxels x stars, once per view.
-// First each star's weight and gradient per voxel (kRow voxels side by side,
-// branch-free: vectorised on the CPU), then the sums over the stars. The CPU
-// runs rows of 16 voxels, the GPU one voxel per thread (kRow 1), summing each
-// output in registers and writing it once (no read-modify-write per star in
-// global memory).
-template <int kRow>
+// The CPU runs rows of 16 voxels: first every star's pair per voxel side by
+// side (vectorised), then the sums star by star. The GPU runs one voxel per
+// thread (kRow 1) with kFN >= F N: star by star into 4 F N sums held in
+// registers, each output written once (kFN 0: the CPU's order, its per-star
+// arrays in local memory).
+template <int kRow, int kFN = 0>
 NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int x0, int y, int z, float* light,
                            unsigned* near) {
   const GridShape& g = s.density.shape;
@@ -210,101 +315,81 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
   const size_t cell0 = g.index(x0, y, z);
   const int FN = s.n_acc * s.n_basis;
   const Vec3 c0 = g.centre(x0, y, z);
-  float ex[kRow], ey[kRow], ez[kRow], inv_rho[kRow], tau[kRow];
-  for (int i = 0; i < n; ++i) {
-    const Vec3 centre{c0.x + float(i) * g.voxel, c0.y, c0.z};
-    const Vec3 e = camera.to_eye(centre);
-    ex[i] = e.x;
-    ey[i] = e.y;
-    ez[i] = e.z;
-    // 1 / distance to the eye: the rays' direction turns by (offset / distance) across the voxel.
+  // The rays' direction turns by (offset / distance to the eye) across the voxel.
+  auto inv_rho_of = [&](Vec3 centre) {
     const float rho = length(camera.position - centre);
-    inv_rho[i] = camera.projection == Projection::Orthographic || !(rho > 0.0f) ? 0.0f : 1.0f / rho;
-    tau[i] = s.density.tau_v[cell0 + i];
-  }
-  const float near2 = 0.5f * s.near_distance * s.near_distance, g2 = s.g * s.g;
-  const float phase_norm = (1.0f - g2) * kInv4Pi * s.albedo, inv_step = 1.0f / s.depth_step;
-  const float last = float(s.n_depth - 1);
-  // Per star and voxel: weight, its gradient, the table position; the near mask.
-  float w[kMaxVoxelLightStars][kRow], gx[kMaxVoxelLightStars][kRow], gy[kMaxVoxelLightStars][kRow],
-      gz[kMaxVoxelLightStars][kRow], xd[kMaxVoxelLightStars][kRow], is_near[kMaxVoxelLightStars][kRow];
-  for (int k = 0; k < s.n_stars; ++k) {
-    const Vec3 star = s.stars[k].position;
-    const float* depth = s.stars[k].depth_v + cell0;
-    const float power = s.stars[k].power * kInv4Pi * phase_norm;
-    for (int i = 0; i < n; ++i) {  // branch-free: arithmetic and masks, no early exits
-      const float dx = c0.x + float(i) * g.voxel - star.x, dy = c0.y - star.y, dz = c0.z - star.z;
-      const float r2 = dx * dx + dy * dy + dz * dz;
-      const float inv_r = 1.0f / sqrtf(r2 + 1e-30f);
-      const float hx = dx * inv_r, hy = dy * inv_r, hz = dz * inv_r;
-      const float mu = hx * ex[i] + hy * ey[i] + hz * ez[i];
-      // The expansion's error is second order, (offset / r)^2 times the curvature of ln w
-      // in the angle seen from the star: 2 for 1/r^2, plus the phase's |d^2 ln p / d theta^2|
-      // (3g / (1 - g)^2 in forward scattering: 11 at g = 0.6). near_distance holds for
-      // the curvature 2 of 1/r^2 alone; a sharper phase widens it as the square root.
-      const float A = 1.0f + g2 - 2.0f * s.g * mu, inv_A = 1.0f / A;
-      const float curvature = 2.0f + fabsf(3.0f * s.g * (mu * A - 2.0f * s.g * (1.0f - mu * mu))) * inv_A * inv_A;
-      const float lit = tau[i] > 0.0f ? 1.0f : 0.0f;
-      const float close = r2 < near2 * curvature ? lit : 0.0f;
-      const float x = depth[i] * inv_step;
-      // Products of 0/1 flags, not &&: no branch (beyond the table: below the transmittance cut).
-      const float take = (lit - close) * (x < last ? 1.0f : 0.0f);
-      // r^2 softened by the pixel's footprint at the star, as chord_irradiance does (a ray
-      // stands for its pixel): 1 / (r^2 + w^2 / (4 pi)).
-      const float t_star = (camera.position.x - star.x) * ex[i] + (camera.position.y - star.y) * ey[i] +
-                           (camera.position.z - star.z) * ez[i];
-      const float width = s.footprint.width_at_eye + 0.5f * (t_star + fabsf(t_star)) * s.footprint.spread;
-      const float inv_r2 = 1.0f / (r2 + width * width * kInv4Pi);
-      const float wi = power * tau[i] * inv_r2 * inv_A * sqrtf(inv_A) * take;
-      // grad ln w = -2 d / r2 + (d ln p / d mu) grad mu, grad mu = (e - mu h) / r - (h - mu e) / rho.
-      const float a = -2.0f * inv_r2, b = 3.0f * s.g * inv_A;
-      gx[k][i] = wi * (a * dx + b * (inv_r * (ex[i] - mu * hx) - inv_rho[i] * (hx - mu * ex[i])));
-      gy[k][i] = wi * (a * dy + b * (inv_r * (ey[i] - mu * hy) - inv_rho[i] * (hy - mu * ey[i])));
-      gz[k][i] = wi * (a * dz + b * (inv_r * (ez[i] - mu * hz) - inv_rho[i] * (hz - mu * ez[i])));
-      w[k][i] = wi;
-      xd[k][i] = x * take;
-      is_near[k][i] = close;
+    return camera.projection == Projection::Orthographic || !(rho > 0.0f) ? 0.0f : 1.0f / rho;
+  };
+  if constexpr (kRow == 1 && kFN > 0) {
+    const Vec3 e = camera.to_eye(c0);
+    const float inv_rho = inv_rho_of(c0), tau = s.density.tau_v[cell0];
+    float u[4 * kFN];
+    for_each_index<4 * kFN>(4 * kFN, [&](int i) { u[i] = 0.0f; });
+    unsigned mask = 0;
+    for (int k = 0; k < s.n_stars; ++k) {
+      const VoxelStarPair p = voxel_star_pair(s, camera, c0, e, inv_rho, tau, k, s.stars[k].depth_v[cell0]);
+      mask |= unsigned(p.near != 0.0f) << k;
+      if (p.w == 0.0f) continue;
+      const int d0 = int(p.x);
+      add_star_light<kFN>(u, kFN, s.star_coeff + (size_t(k) * s.n_depth + d0) * FN, FN, p.x - float(d0), p.w,
+                          Vec3{p.gx, p.gy, p.gz});
     }
-  }
-  for (int i = 0; i < n; ++i) {
-    float* u = light + (cell0 + i) * 4 * FN;
-    if constexpr (kRow == 1) {  // GPU: each output summed over the stars in registers, written once
-      for (int j = 0; j < FN; ++j) {
-        float a0 = 0.0f, a1 = 0.0f, a2 = 0.0f, a3 = 0.0f;
-        for (int k = 0; k < s.n_stars; ++k) {
-          if (w[k][i] == 0.0f) continue;
-          const int d0 = int(xd[k][i]);
-          const float* q = s.star_coeff + (size_t(k) * s.n_depth + d0) * FN + j;
-          const float v = q[0] + (xd[k][i] - float(d0)) * (q[FN] - q[0]);
-          a0 += w[k][i] * v;
-          a1 += gx[k][i] * v;
-          a2 += gy[k][i] * v;
-          a3 += gz[k][i] * v;
-        }
-        u[j] = a0;
-        u[FN + j] = a1;
-        u[2 * FN + j] = a2;
-        u[3 * FN + j] = a3;
+    float* out = light + cell0 * 4 * FN;
+    for_each_index<kFN>(FN, [&](int i) {
+      out[i] = u[i];
+      out[FN + i] = u[kFN + i];
+      out[2 * FN + i] = u[2 * kFN + i];
+      out[3 * FN + i] = u[3 * kFN + i];
+    });
+    near[cell0] = mask;
+  } else {
+    Vec3 e[kRow];
+    float inv_rho[kRow], tau[kRow];
+    for (int i = 0; i < n; ++i) {
+      const Vec3 centre{c0.x + float(i) * g.voxel, c0.y, c0.z};
+      e[i] = camera.to_eye(centre);
+      inv_rho[i] = inv_rho_of(centre);
+      tau[i] = s.density.tau_v[cell0 + i];
+    }
+    // Per star and voxel: weight, its gradient, the table position; the near mask.
+    float w[kMaxVoxelLightStars][kRow], gx[kMaxVoxelLightStars][kRow], gy[kMaxVoxelLightStars][kRow],
+        gz[kMaxVoxelLightStars][kRow], xd[kMaxVoxelLightStars][kRow], is_near[kMaxVoxelLightStars][kRow];
+    for (int k = 0; k < s.n_stars; ++k) {
+      const float* depth = s.stars[k].depth_v + cell0;
+      for (int i = 0; i < n; ++i) {
+        const Vec3 centre{c0.x + float(i) * g.voxel, c0.y, c0.z};
+        const VoxelStarPair p = voxel_star_pair(s, camera, centre, e[i], inv_rho[i], tau[i], k, depth[i]);
+        w[k][i] = p.w;
+        gx[k][i] = p.gx;
+        gy[k][i] = p.gy;
+        gz[k][i] = p.gz;
+        xd[k][i] = p.x;
+        is_near[k][i] = p.near;
       }
-    } else {  // CPU: star by star, the outputs contiguous (vectorised; the voxel's light stays in cache)
+    }
+    for (int i = 0; i < n; ++i) {
+      float* u = light + (cell0 + i) * 4 * FN;
       for (int j = 0; j < 4 * FN; ++j) u[j] = 0.0f;
       for (int k = 0; k < s.n_stars; ++k) {
         if (w[k][i] == 0.0f) continue;
         const int d0 = int(xd[k][i]);
-        add_star_light(u, s.star_coeff + (size_t(k) * s.n_depth + d0) * FN, FN, xd[k][i] - float(d0), w[k][i],
+        add_star_light(u, FN, s.star_coeff + (size_t(k) * s.n_depth + d0) * FN, FN, xd[k][i] - float(d0), w[k][i],
                        Vec3{gx[k][i], gy[k][i], gz[k][i]});
       }
+      unsigned mask = 0;
+      for (int k = 0; k < s.n_stars; ++k) mask |= unsigned(is_near[k][i] != 0.0f) << k;
+      near[cell0 + i] = mask;
     }
-    unsigned mask = 0;
-    for (int k = 0; k < s.n_stars; ++k) mask |= unsigned(is_near[k][i] != 0.0f) << k;
-    near[cell0 + i] = mask;
   }
 }
 
 // One ray: the accumulators (n_acc of them) before the resolve.
-template <SpectralMethod kMethod>
-NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir, float* acc) {
-  for (int k = 0; k < s.n_acc; ++k) acc[k] = 0.0f;
+template <SpectralMethod kMethod, class Acc>
+NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir, Acc& acc) {
+  acc.cols = accumulator_cols(s);
+  for_each_index<Acc::kRows>(accumulator_rows(s), [&](int r) {
+    for_each_index<Acc::kCols>(acc.cols, [&](int c) { acc(r, c) = 0.0f; });
+  });
   const GridShape& g = s.density.shape;
   const Vec3 span = g.upper() - g.origin;
   const float far = length(origin - (g.origin + 0.5f * span)) + length(span) + g.voxel;
@@ -317,19 +402,19 @@ NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir,
     const float tau_v = s.density.tau_v[cell];
     const float fraction = chord * inv_voxel;
     if constexpr (kMethod == SpectralMethod::VoxelLight) {
-      float c[kMaxBasis];
-      if (tau_v > 0.0f && depth_coefficients(s, s.coeff, s.n_basis, eye_depth, c)) {
+      float c[Acc::kBasis > 0 ? Acc::kBasis : kMaxBasis];
+      if (tau_v > 0.0f && depth_coefficients<Acc::kBasis>(s, s.coeff, s.n_basis, eye_depth, c)) {
         const int F = s.n_acc, N = s.n_basis, FN = F * N;
         const float* u = s.voxel_light + cell * 4 * FN;
         const Vec3 delta = origin + (t + 0.5f * chord) * dir - g.centre(ix, iy, iz);
-        for (int f = 0; f < F; ++f) {
+        for_each_index<Acc::kCols>(F, [&](int f) {
           float sum = 0.0f;
-          for (int j = 0; j < N; ++j) {
+          for_each_index<Acc::kBasis>(N, [&](int j) {
             const int i = f * N + j;
             sum += c[j] * (u[i] + delta.x * u[FN + i] + delta.y * u[2 * FN + i] + delta.z * u[3 * FN + i]);
-          }
-          acc[f] += fraction * sum;
-        }
+          });
+          acc(0, f) += fraction * sum;
+        });
         for (unsigned near = s.near_stars[cell]; near != 0u; near &= near - 1u) {
           int k = 0;
           while (!((near >> k) & 1u)) ++k;
@@ -341,25 +426,26 @@ NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir,
           const float r = length(d);
           const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
           const float w = s.stars[k].power * kInv4Pi * at.inv_r2 * s.albedo * tau_v * hg_phase(mu, s.g) * fraction;
-          for (int f = 0; f < F; ++f) {
+          for_each_index<Acc::kCols>(F, [&](int f) {
             float sum = 0.0f;
-            for (int j = 0; j < N; ++j) {
+            for_each_index<Acc::kBasis>(N, [&](int j) {
               const int i = f * N + j;
               sum += c[j] * (q[i] + fd * (q[FN + i] - q[i]));
-            }
-            acc[f] += w * sum;
-          }
+            });
+            acc(0, f) += w * sum;
+          });
         }
       }
     } else if (tau_v > 0.0f) {
-      for (int k = 0; k < s.n_stars; ++k) {
+      // Projection's accumulators have a row per star: unrolled over the stars, so that row is a constant.
+      for_each_index<kMethod == SpectralMethod::Projection ? Acc::kRows : 0>(s.n_stars, [&](int k) {
         const ChordIrradiance at = chord_irradiance(origin, dir, t, t + chord, s.stars[k].position, s.footprint);
         const Vec3 d = at.point - s.stars[k].position;
         const float r = length(d);
         const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
         const float w = s.stars[k].power * kInv4Pi * at.inv_r2 * s.albedo * tau_v * hg_phase(mu, s.g) * fraction;
         add_pair<kMethod>(s, k, w, s.stars[k].depth_v[cell] + eye_depth, acc);
-      }
+      });
     }
     t += chord;
     eye_depth += tau_v * fraction;

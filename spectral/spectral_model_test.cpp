@@ -23,10 +23,11 @@ double pair_value(const SpectralModel& m, int filter, int star, double D) {
   std::vector<SpectralStarView> stars(size_t(m.n_stars));
   for (int k = 0; k < m.n_stars; ++k) stars[k].temperature_u = m.temperature_u.empty() ? 0.0f : m.temperature_u[k];
   v.stars = stars.data();
-  float acc[kMaxAccumulators] = {};
+  DynamicAccumulators acc{};
+  acc.cols = accumulator_cols(v);
   dispatch_method(m.settings.method, [&](auto method) { add_pair<method()>(v, star, 1.0f, float(D), acc); });
   double sum = 0;
-  for (int k = 0; k < m.n_acc; ++k) sum += double(m.resolve[size_t(filter) * m.n_acc + k]) * acc[k];
+  for (int k = 0; k < m.n_acc; ++k) sum += double(m.resolve[size_t(filter) * m.n_acc + k]) * acc.v[k];
   return sum;
 }
 

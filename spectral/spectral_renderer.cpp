@@ -65,13 +65,13 @@ Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds) {
   }
   dispatch_method(m.settings.method, [&](auto method) {
     tbb::parallel_for(tbb::blocked_range<int>(0, in.camera.height), [&](const auto& rows) {
-      float acc[kMaxAccumulators];
+      DynamicAccumulators acc;  // run-time extents: registers matter on the GPU, not here
       for (int y = rows.begin(); y != rows.end(); ++y)
         for (int x = 0; x < in.camera.width; ++x) {
           Vec3 origin, dir;
           if (!in.camera.ray(x, y, origin, dir)) continue;
           march_spectral<method()>(view, origin, dir, acc);
-          for (int k = 0; k < m.n_acc; ++k) image.at(k, x, y) = acc[k];
+          store_accumulators(view, acc, &image.at(0, x, y), image.plane_size());
         }
     });
   });

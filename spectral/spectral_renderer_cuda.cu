@@ -15,26 +15,71 @@
 namespace nebula::spectral {
 namespace {
 
-template <SpectralMethod kMethod>
+template <SpectralMethod kMethod, class Acc>
 __global__ void spectral_kernel(SpectralSceneView scene, Camera camera, float* pixels) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x;
   const int y = blockIdx.y * blockDim.y + threadIdx.y;
   if (x >= camera.width || y >= camera.height) return;
   Vec3 origin, dir;
   if (!camera.ray(x, y, origin, dir)) return;
-  float acc[kMaxAccumulators];
+  Acc acc;
   march_spectral<kMethod>(scene, origin, dir, acc);
-  const size_t plane = size_t(camera.width) * camera.height;
-  for (int k = 0; k < scene.n_acc; ++k) pixels[k * plane + size_t(y) * camera.width + x] = acc[k];
+  store_accumulators(scene, acc, pixels + size_t(y) * camera.width + x, size_t(camera.width) * camera.height);
 }
 
-// VoxelLight's per-view pre-pass: one thread per voxel (spectral_march.h).
+// VoxelLight's per-view pre-pass: one voxel per thread (spectral_march.h);
+// kFN >= F N keeps its sums in registers.
+template <int kFN>
 __global__ void voxel_light_kernel(SpectralSceneView scene, Camera camera, float* light, unsigned* near) {
   const GridShape& g = scene.density.shape;
   const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i >= g.count()) return;
   const int x = int(i % g.nx), y = int((i / g.nx) % g.ny), z = int(i / (size_t(g.nx) * g.ny));
-  voxel_light<1>(scene, camera, x, y, z, light, near);
+  voxel_light<1, kFN>(scene, camera, x, y, z, light, near);
+}
+
+// The smallest of the bounds in `sizes` that holds n, or 0 (run-time extents).
+template <int... kSizes>
+constexpr int bucket(int n) {
+  int out = 0;
+  ((out = out == 0 && n <= kSizes ? kSizes : out), ...);
+  return out;
+}
+
+// Launches kernel<kMethod, Acc>() with the accumulators' compile-time bounds
+// (RayAccumulators): per method the smallest bucket that holds the run's
+// rows, columns and basis, or run-time extents beyond them.
+template <SpectralMethod kMethod, class Launch>
+void with_accumulators(const SpectralSceneView& v, Launch&& launch) {
+  const int rows = accumulator_rows(v), cols = accumulator_cols(v);
+  auto by_cols = [&](auto rows_bound, auto basis_bound) {
+    constexpr int R = decltype(rows_bound)::value, B = decltype(basis_bound)::value;
+    switch (bucket<4, 8>(cols)) {
+      case 4: launch(RayAccumulators<R, 4, B == -1 ? 4 : B>()); break;
+      case 8: launch(RayAccumulators<R, 8, B == -1 ? 8 : B>()); break;
+      default: launch(DynamicAccumulators()); break;
+    }
+  };
+  using I = std::integral_constant<int, 1>;
+  if constexpr (kMethod == SpectralMethod::Projection) {  // a row per star, basis in the columns
+    switch (bucket<1, 2, 4, 8>(rows)) {
+      case 1: by_cols(I(), std::integral_constant<int, -1>()); break;
+      case 2: by_cols(std::integral_constant<int, 2>(), std::integral_constant<int, -1>()); break;
+      case 4: by_cols(std::integral_constant<int, 4>(), std::integral_constant<int, -1>()); break;
+      case 8: by_cols(std::integral_constant<int, 8>(), std::integral_constant<int, -1>()); break;
+      default: launch(DynamicAccumulators()); break;
+    }
+  } else if constexpr (kMethod == SpectralMethod::VoxelLight) {  // filters in the columns, the basis apart
+    switch (bucket<4, 8>(v.n_basis)) {
+      case 4: by_cols(I(), std::integral_constant<int, 4>()); break;
+      case 8: by_cols(I(), std::integral_constant<int, 8>()); break;
+      default: launch(DynamicAccumulators()); break;
+    }
+  } else if constexpr (kMethod == SpectralMethod::Analytic) {  // far from register-bound: one kernel
+    launch(DynamicAccumulators());
+  } else {  // Double (filters), LightBasis (basis) in the columns
+    by_cols(I(), std::integral_constant<int, -1>());
+  }
 }
 
 template <class T>
@@ -84,10 +129,18 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
   DeviceArray<float> pixels(image.pixels.size());
   const dim3 block(16, 16), grid((in.camera.width + 15) / 16, (in.camera.height + 15) / 16);
   CudaEventTimer timer;
-  if (voxel)  // the pre-pass, timed with the march
-    voxel_light_kernel<<<unsigned((cells + 255) / 256), 256>>>(view, in.camera, light.get(), near.get());
+  const unsigned pre_blocks = unsigned((cells + 255) / 256);
+  if (voxel) {  // the pre-pass, timed with the march
+    const int FN = m.n_acc * int(m.basis.size());
+    if (FN <= 16)
+      voxel_light_kernel<16><<<pre_blocks, 256>>>(view, in.camera, light.get(), near.get());
+    else
+      voxel_light_kernel<0><<<pre_blocks, 256>>>(view, in.camera, light.get(), near.get());
+  }
   dispatch_method(m.settings.method, [&](auto method) {
-    spectral_kernel<method()><<<grid, block>>>(view, in.camera, pixels.get());
+    with_accumulators<method()>(view, [&](auto acc) {
+      spectral_kernel<method(), decltype(acc)><<<grid, block>>>(view, in.camera, pixels.get());
+    });
   });
   NEBULA_CUDA_CHECK(cudaGetLastError());
   const double s = timer.seconds();
