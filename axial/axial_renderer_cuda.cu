@@ -17,7 +17,8 @@
 namespace nebula {
 namespace {
 
-// Blocks of 256 threads per SM the compiler must fit in registers.
+// Blocks of 256 threads per SM the compiler must fit in registers (the launch uses blocks of
+// 128, below: the same register budget, 6 of them).
 #ifndef NEBULA_AXIAL_MIN_BLOCKS
 #define NEBULA_AXIAL_MIN_BLOCKS 3  // with the band loops unrolled, at most 80 registers: 15-35% faster (H100, docs/performance.md)
 #endif
@@ -46,10 +47,13 @@ Image render_axial_cuda(const AxialRenderInputs& in, AxialRenderStats* stats) {
   Image image(in.camera.width, in.camera.height, band_names(in.bands));
   DeviceArray<float> pixels(image.pixels.size());
   DeviceArray<unsigned long long> clamps(1);
+  // Blocks of 8 x 16 rays: a block holds its multiprocessor slot until its slowest warp ends,
+  // and skipping makes the rays' work very uneven, so smaller blocks waste less. Faster than
+  // 16 x 16 in every mode measured (H100: distance 5-14%, the naive march 1-9%; docs/performance.md).
 #ifndef NEBULA_AXIAL_BLOCK_X
-#define NEBULA_AXIAL_BLOCK_X 16
+#define NEBULA_AXIAL_BLOCK_X 8
 #endif
-  constexpr int bx = NEBULA_AXIAL_BLOCK_X, by = 256 / bx;
+  constexpr int bx = NEBULA_AXIAL_BLOCK_X, by = 128 / bx;
   const dim3 block(bx, by), grid((in.camera.width + bx - 1) / bx, (in.camera.height + by - 1) / by);
   CudaEventTimer timer;
   dispatch_axial(scene.skip, scene.n_stars > 0, scene.has_diffuse, in.deform.any(),
