@@ -229,38 +229,51 @@ NEBULA_HD const float* star_integrals(const SpectralSceneView& s, int k, size_t 
 }
 
 // u[c * stride + i] += (w, grad)[c] times the star's row q interpolated at fd,
-// for c = 0 .. 3 and i < FN (restrict: the table and the voxel's light never
-// overlap, so the CPU's loop vectorises; kFN > 0 bounds FN for the GPU's
-// register sums, whose stride is kFN).
+// for c = 0 .. 3 and i < FN. kFN > 0 bounds FN at compile time for the GPU's
+// register sums (stride kFN; the loop unrolls, so every index is a constant);
+// with kFN = 0 it is the CPU's plain loop, which vectorises.
 template <int kFN = 0>
 NEBULA_HD void add_star_light(float* __restrict__ u, int stride, const float* __restrict__ q, int FN, float fd,
                               float w, Vec3 grad) {
-  for_each_index<kFN>(FN, [&](int i) {
+  NEBULA_UNROLL
+  for (int i = 0; i < (kFN > 0 ? kFN : FN); ++i) {
+    if (kFN > 0 && i >= FN) break;
     const float v = q[i] + fd * (q[FN + i] - q[i]);
     u[i] += w * v;
     u[stride + i] += grad.x * v;
     u[2 * stride + i] += grad.y * v;
     u[3 * stride + i] += grad.z * v;
-  });
+  }
 }
 
 // VoxelLight: one voxel-star pair of the pre-pass, for a voxel at `centre`
 // (e its direction to the eye, inv_rho 1 / its distance from the eye or 0,
-// tau its V-band depth) and star k at V-band depth `depth` from it: the
-// weight w = a tau_V L/(4 pi r^2) p_HG(mu) (0 where the pair is not summed:
-// an empty voxel, a near pair, beyond the table), its gradient, the star
-// table's depth coordinate x and near = 1 where the march takes the pair
-// exactly. Branch-free: arithmetic and 0/1 masks, so that the CPU's rows of
-// voxels vectorise.
+// tau its V-band depth) and a star at `star` (power: its luminosity times
+// a (1 - g^2) / (4 pi)^2, VoxelLightConstants::power) at V-band depth `depth`
+// from the voxel: the weight w = a tau_V L/(4 pi r^2) p_HG(mu) (0 where the
+// pair is not summed: an empty voxel, a near pair, beyond the table), its
+// gradient, the star table's depth coordinate x and near = 1 where the march
+// takes the pair exactly. Branch-free: arithmetic and 0/1 masks, so that the
+// CPU's rows of voxels vectorise.
 struct VoxelStarPair {
   float w, gx, gy, gz, x, near;
 };
-NEBULA_HD VoxelStarPair voxel_star_pair(const SpectralSceneView& s, const Camera& camera, Vec3 centre, Vec3 e,
-                                        float inv_rho, float tau, int k, float depth) {
-  const float near2 = 0.5f * s.near_distance * s.near_distance, g2 = s.g * s.g;
-  const float phase_norm = (1.0f - g2) * kInv4Pi * s.albedo;
-  const Vec3 star = s.stars[k].position;
-  const float power = s.stars[k].power * kInv4Pi * phase_norm;
+// What every pair of one pre-pass shares, and star k's part (taken out of the
+// loop over the voxels by hand: the CPU's loop vectorises only so).
+struct VoxelLightConstants {
+  float near2, g2, phase_norm, inv_step, last;
+  NEBULA_HD explicit VoxelLightConstants(const SpectralSceneView& s)
+      : near2(0.5f * s.near_distance * s.near_distance), g2(s.g * s.g),
+        phase_norm((1.0f - s.g * s.g) * kInv4Pi * s.albedo), inv_step(1.0f / s.depth_step),
+        last(float(s.n_depth - 1)) {}
+  NEBULA_HD float power(const SpectralSceneView& s, int k) const {
+    return s.stars[k].power * kInv4Pi * phase_norm;
+  }
+};
+NEBULA_HD VoxelStarPair voxel_star_pair(const SpectralSceneView& s, const Camera& camera,
+                                        const VoxelLightConstants& c, Vec3 star, float power, Vec3 centre, Vec3 e,
+                                        float inv_rho, float tau, float depth) {
+  const float near2 = c.near2, g2 = c.g2;
   const float dx = centre.x - star.x, dy = centre.y - star.y, dz = centre.z - star.z;
   const float r2 = dx * dx + dy * dy + dz * dz;
   const float inv_r = 1.0f / sqrtf(r2 + 1e-30f);
@@ -274,9 +287,9 @@ NEBULA_HD VoxelStarPair voxel_star_pair(const SpectralSceneView& s, const Camera
   const float curvature = 2.0f + fabsf(3.0f * s.g * (mu * A - 2.0f * s.g * (1.0f - mu * mu))) * inv_A * inv_A;
   const float lit = tau > 0.0f ? 1.0f : 0.0f;
   const float close = r2 < near2 * curvature ? lit : 0.0f;
-  const float x = depth / s.depth_step;
+  const float x = depth * c.inv_step;
   // Products of 0/1 flags, not &&: no branch (beyond the table: below the transmittance cut).
-  const float take = (lit - close) * (x < float(s.n_depth - 1) ? 1.0f : 0.0f);
+  const float take = (lit - close) * (x < c.last ? 1.0f : 0.0f);
   // r^2 softened by the pixel's footprint at the star, as chord_irradiance does (a ray
   // stands for its pixel): 1 / (r^2 + w^2 / (4 pi)).
   const float t_star =
@@ -315,6 +328,7 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
   const size_t cell0 = g.index(x0, y, z);
   const int FN = s.n_acc * s.n_basis;
   const Vec3 c0 = g.centre(x0, y, z);
+  const VoxelLightConstants constants(s);
   // The rays' direction turns by (offset / distance to the eye) across the voxel.
   auto inv_rho_of = [&](Vec3 centre) {
     const float rho = length(camera.position - centre);
@@ -327,7 +341,8 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
     for_each_index<4 * kFN>(4 * kFN, [&](int i) { u[i] = 0.0f; });
     unsigned mask = 0;
     for (int k = 0; k < s.n_stars; ++k) {
-      const VoxelStarPair p = voxel_star_pair(s, camera, c0, e, inv_rho, tau, k, s.stars[k].depth_v[cell0]);
+      const VoxelStarPair p = voxel_star_pair(s, camera, constants, s.stars[k].position, constants.power(s, k), c0, e,
+                                              inv_rho, tau, s.stars[k].depth_v[cell0]);
       mask |= unsigned(p.near != 0.0f) << k;
       if (p.w == 0.0f) continue;
       const int d0 = int(p.x);
@@ -343,11 +358,15 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
     });
     near[cell0] = mask;
   } else {
-    Vec3 e[kRow];
-    float inv_rho[kRow], tau[kRow];
+    // Per voxel: the way to the eye, 1 / distance to it, the depth; one array per
+    // component (not Vec3s), so that the loop over the voxels below vectorises.
+    float ex[kRow], ey[kRow], ez[kRow], inv_rho[kRow], tau[kRow];
     for (int i = 0; i < n; ++i) {
       const Vec3 centre{c0.x + float(i) * g.voxel, c0.y, c0.z};
-      e[i] = camera.to_eye(centre);
+      const Vec3 e = camera.to_eye(centre);
+      ex[i] = e.x;
+      ey[i] = e.y;
+      ez[i] = e.z;
       inv_rho[i] = inv_rho_of(centre);
       tau[i] = s.density.tau_v[cell0 + i];
     }
@@ -356,9 +375,13 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
         gz[kMaxVoxelLightStars][kRow], xd[kMaxVoxelLightStars][kRow], is_near[kMaxVoxelLightStars][kRow];
     for (int k = 0; k < s.n_stars; ++k) {
       const float* depth = s.stars[k].depth_v + cell0;
+      const Vec3 star = s.stars[k].position;
+      const float power = constants.power(s, k);
       for (int i = 0; i < n; ++i) {
         const Vec3 centre{c0.x + float(i) * g.voxel, c0.y, c0.z};
-        const VoxelStarPair p = voxel_star_pair(s, camera, centre, e[i], inv_rho[i], tau[i], k, depth[i]);
+        const VoxelStarPair p =
+            voxel_star_pair(s, camera, constants, star, power, centre, Vec3{ex[i], ey[i], ez[i]}, inv_rho[i], tau[i],
+                            depth[i]);
         w[k][i] = p.w;
         gx[k][i] = p.gx;
         gy[k][i] = p.gy;
