@@ -46,6 +46,10 @@ constexpr int bucket(int n) {
   return out;
 }
 
+template <int N>
+using Int = std::integral_constant<int, N>;
+constexpr int kBasisInColumns = 0;  // the basis size is the column count (Projection, LightBasis; Double: unused)
+
 // Launches kernel<kMethod, Acc>() with the accumulators' compile-time bounds
 // (RayAccumulators): per method the smallest bucket that holds the run's
 // rows, columns and basis, or run-time extents beyond them.
@@ -55,30 +59,29 @@ void with_accumulators(const SpectralSceneView& v, Launch&& launch) {
   auto by_cols = [&](auto rows_bound, auto basis_bound) {
     constexpr int R = decltype(rows_bound)::value, B = decltype(basis_bound)::value;
     switch (bucket<4, 8>(cols)) {
-      case 4: launch(RayAccumulators<R, 4, B == -1 ? 4 : B>()); break;
-      case 8: launch(RayAccumulators<R, 8, B == -1 ? 8 : B>()); break;
+      case 4: launch(RayAccumulators<R, 4, B == kBasisInColumns ? 4 : B>()); break;
+      case 8: launch(RayAccumulators<R, 8, B == kBasisInColumns ? 8 : B>()); break;
       default: launch(DynamicAccumulators()); break;
     }
   };
-  using I = std::integral_constant<int, 1>;
   if constexpr (kMethod == SpectralMethod::Projection) {  // a row per star, basis in the columns
     switch (bucket<1, 2, 4, 8>(rows)) {
-      case 1: by_cols(I(), std::integral_constant<int, -1>()); break;
-      case 2: by_cols(std::integral_constant<int, 2>(), std::integral_constant<int, -1>()); break;
-      case 4: by_cols(std::integral_constant<int, 4>(), std::integral_constant<int, -1>()); break;
-      case 8: by_cols(std::integral_constant<int, 8>(), std::integral_constant<int, -1>()); break;
+      case 1: by_cols(Int<1>(), Int<kBasisInColumns>()); break;
+      case 2: by_cols(Int<2>(), Int<kBasisInColumns>()); break;
+      case 4: by_cols(Int<4>(), Int<kBasisInColumns>()); break;
+      case 8: by_cols(Int<8>(), Int<kBasisInColumns>()); break;
       default: launch(DynamicAccumulators()); break;
     }
   } else if constexpr (kMethod == SpectralMethod::VoxelLight) {  // filters in the columns, the basis apart
     switch (bucket<4, 8>(v.n_basis)) {
-      case 4: by_cols(I(), std::integral_constant<int, 4>()); break;
-      case 8: by_cols(I(), std::integral_constant<int, 8>()); break;
+      case 4: by_cols(Int<1>(), Int<4>()); break;
+      case 8: by_cols(Int<1>(), Int<8>()); break;
       default: launch(DynamicAccumulators()); break;
     }
   } else if constexpr (kMethod == SpectralMethod::Analytic) {  // far from register-bound: one kernel
     launch(DynamicAccumulators());
   } else {  // Double (filters), LightBasis (basis) in the columns
-    by_cols(I(), std::integral_constant<int, -1>());
+    by_cols(Int<1>(), Int<kBasisInColumns>());
   }
 }
 
