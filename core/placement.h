@@ -7,6 +7,7 @@
 // differ only in where the arrays live, never in how the scene is put together.
 #include <cstddef>
 #include <memory>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -28,9 +29,13 @@ class HostPlacement {
     return place(v);
   }
   // An array that may live on the device only: fetch() gives the host copy.
+  // A fetch() that makes the array (returns it by value) has it kept here.
   template <class Fetch>
   auto place_mirrored(DeviceMirror&, size_t, Fetch&& fetch) {
-    return place(fetch());
+    if constexpr (std::is_reference_v<decltype(fetch())>)
+      return place(fetch());
+    else
+      return keep(fetch());
   }
   // An array made while assembling (per-star views, say), kept alive here.
   template <class T>

@@ -23,6 +23,12 @@ namespace nebula {
 struct ChordIrradiance {
   float inv_r2 = 0;  // mean of 1 / r^2 (softened) over the chord
   Vec3 point;        // where half of the chord's light has been received: theta is taken here
+  // The angles atan((t - t_c) / b) at the chord's ends (a0 <= a1) where the
+  // closed form below is taken (near the star), else both 0. The chord's light
+  // is spread evenly over a in [a0, a1] (ds / (b^2 + s^2) = da / b), and the
+  // scattering angle towards the eye is theta = pi/2 + a (ray_march.h,
+  // chord_phase_mean).
+  float a0 = 0, a1 = 0;
 };
 
 // The chord from origin + t0 dir to origin + t1 dir (unit dir) of a ray with
@@ -51,6 +57,8 @@ NEBULA_HD ChordIrradiance chord_irradiance(Vec3 origin, Vec3 dir, float t0, floa
   const float b = sqrtf(b2);
   const float a0 = atanf((t0 - tc) / b), a1 = atanf((t1 - tc) / b);
   out.inv_r2 = (a1 - a0) / (b * chord);
+  out.a0 = a0;
+  out.a1 = a1;
   const float t = tc + b * tanf(0.5f * (a0 + a1));
   out.point = origin + fminf(fmaxf(t, t0), t1) * dir;
   return out;

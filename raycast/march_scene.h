@@ -2,6 +2,7 @@
 // The ray marcher's kernel scene, assembled once from RenderInputs for both
 // backends (core/placement.h): the CPU path places the host arrays
 // themselves, the CUDA path uploads them. Host code only.
+#include <cmath>
 #include <utility>
 #include <vector>
 
@@ -55,6 +56,14 @@ MarchScene assemble_march_scene(const RenderInputs& in, Place& place) {
   }
   scene.stars = place_star_views(in.stars, scene.n_bands, place);
   scene.n_stars = static_cast<int>(in.stars.size());
+  // The rays that may take chord_phase_mean (uniform-theta tables); the
+  // longest chord through a voxel is its diagonal.
+  int n_mu = 0;
+  for (int b = 0; b < scene.n_bands; ++b)
+    if (scene.albedo[b] > 0.0f && scene.table[b].bins.kind == AngularBinning::UniformTheta &&
+        scene.table[b].n_mu > n_mu)
+      n_mu = scene.table[b].n_mu;
+  scene.near_star_radius = chord_phase_radius(std::sqrt(3.0f) * in.density->shape.voxel, n_mu);
   if (in.diffuse) {
     scene.has_diffuse = true;
     scene.diffuse = place_diffuse(*in.diffuse, place);

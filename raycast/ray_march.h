@@ -46,6 +46,9 @@ struct MarchScene {
   // towards this view's eye, per band, filled before the march by
   // raycast/voxel_sources.h; the march then only carries it to the eye.
   const float* voxel_source[kMaxBands] = {};
+  // Rays passing farther than this from every star take the star's phase at
+  // each chord's half-light point (passes_near_a_star, chord_phase_radius).
+  float near_star_radius = 0.0f;
 };
 
 struct RayResult {
@@ -65,13 +68,53 @@ NEBULA_HD void store_radiance(const RayResult& r, int n_bands, float exposure, f
     if (b < n_bands) pixels[b * plane + size_t(y) * width + x] = exposure * r.radiance[b];
 }
 
+// Near a star a chord sees it under a wide range of angles: with 1 / r^2
+// the chord's light is spread evenly over a = atan(s / b) in [a0, a1]
+// (ChordIrradiance), and the scattering angle towards the eye is
+// theta = pi/2 + a, so the chord scatters the mean of P over those angles.
+// The half-light point takes P at their middle only (the midpoint rule): a
+// chord through the star at 90 degrees, which put the star's own pixels of a
+// uniform sphere (g = 0.6) at 0.74 of the truth (docs/marcher.md, "Star
+// light over a cell's chord"). Spans of kChordPhaseMinBins or more of a
+// uniform-theta table's bins take the mean of its interpolant over them
+// (TableView::mean_over_angles); shorter spans, and uniform-mu tables (whose
+// bins are not uniform in the angle), keep the midpoint.
+constexpr float kChordPhaseMinBins = 2.0f;
+
+// Whether a chord seeing the star over [a0, a1] takes the mean of `table`'s
+// P over those angles.
+NEBULA_HD bool chord_takes_phase_mean(const TableView& table, float a0, float a1) {
+  return table.bins.kind == AngularBinning::UniformTheta &&
+         (a1 - a0) * float(table.n_mu) * (1.0f / kPi) >= kChordPhaseMinBins;
+}
+
+// The mean of P(tau_sct, theta) over theta = pi/2 + a, a in [a0, a1], for
+// uniform-theta bins, where the bin coordinate is linear in the angle.
+NEBULA_HD float chord_phase_mean(const TableView& table, float tau_sct, float a0, float a1, int* clamps) {
+  const float n = float(table.n_mu);
+  // u = (1 - theta / pi) n - 1/2 (AngularBins::position), decreasing in a.
+  const float u_lo = (0.5f - a1 * (1.0f / kPi)) * n - 0.5f, u_hi = (0.5f - a0 * (1.0f / kPi)) * n - 0.5f;
+  return table.mean_over_angles(tau_sct, u_lo, u_hi, clamps);
+}
+
+// The distance from a star beyond which no chord of at most `chord` length
+// spans kChordPhaseMinBins of n_mu angle bins: a chord at distance >= b from
+// the star spans at most chord / b radians (d atan(s / b) / ds <= 1 / b), and
+// the softened b of chord_irradiance is never below the geometric one. 1%
+// above it for the rounding of the angles. 0 for n_mu = 0 (no such table).
+inline float chord_phase_radius(float chord, int n_mu) {
+  return 1.01f * chord * float(n_mu) / (kChordPhaseMinBins * kPi);
+}
+
 // One star's light that dust of V-band depth tau_v per cell sends towards the
 // eye per band, per unit of chord / edge, added to `source`: E P(tau_sct,
 // theta), with E from the star's mean 1 / r^2 over the cell's chord and theta
-// at the chord's point `at` (illumination/chord_irradiance.h). depth_v is the
-// star's baked V-band depth to the cell. Shared by the 3D marcher and the
-// axial one (Scene: n_bands, extinction_ratio, albedo, table).
-template <class Scene>
+// at the chord's point `at` (illumination/chord_irradiance.h), or with
+// kChordPhase P averaged over the chord's angles where they span enough bins
+// (chord_phase_mean). depth_v is the star's baked V-band depth to the cell.
+// Shared by the 3D marcher and the axial one (Scene: n_bands,
+// extinction_ratio, albedo, table).
+template <bool kChordPhase = false, class Scene>
 NEBULA_HD void add_star_light(const Scene& s, Vec3 star, const float* power, float depth_v, const ChordIrradiance& at,
                               float tau_v, Vec3 to_eye, float* source, int* clamps) {
   const Vec3 d = at.point - star;
@@ -84,13 +127,19 @@ NEBULA_HD void add_star_light(const Scene& s, Vec3 star, const float* power, flo
   for (int b = 0; b < kMaxBands; ++b) {
     if (b >= s.n_bands) break;
     if (!(s.albedo[b] > 0.0f)) continue;
+    const float tau_b = tau_v * s.extinction_ratio[b];
+    const float e = power[b] * kInv4Pi * at.inv_r2 * expf(-depth_v * s.extinction_ratio[b]);
+    if constexpr (kChordPhase) {
+      if (chord_takes_phase_mean(s.table[b], at.a0, at.a1)) {
+        source[b] += e * chord_phase_mean(s.table[b], s.albedo[b] * tau_b, at.a0, at.a1, clamps);
+        continue;
+      }
+    }
     if (u_from < 0 || s.table[b].bins.kind != s.table[u_from].bins.kind ||
         s.table[b].bins.n != s.table[u_from].bins.n) {
       u = s.table[b].angle_coordinate(mu);
       u_from = b;
     }
-    const float tau_b = tau_v * s.extinction_ratio[b];
-    const float e = power[b] * kInv4Pi * at.inv_r2 * expf(-depth_v * s.extinction_ratio[b]);
     source[b] += e * s.table[b].lookup_at(s.albedo[b] * tau_b, u, clamps);
   }
 }
@@ -99,13 +148,27 @@ NEBULA_HD void add_star_light(const Scene& s, Vec3 star, const float* power, flo
 // per band, per unit of chord / l: sum over stars of E_s P(tau_sct, theta_s).
 // irradiance_of(k) is star k's ChordIrradiance over the chord (or at the
 // sample), depth_of(k) its baked V-band depth to the voxel.
-template <class IrradianceOf, class DepthOf>
+template <bool kChordPhase = false, class IrradianceOf, class DepthOf>
 NEBULA_HD void scattered_source(const MarchScene& s, float tau_v, Vec3 to_eye, IrradianceOf&& irradiance_of,
                                 DepthOf&& depth_of, float* source, int* clamps) {
   if (!(tau_v > 0.0f)) return;
   for (int k = 0; k < s.n_stars; ++k)
-    add_star_light(s, s.stars[k].position, s.stars[k].power, depth_of(k), irradiance_of(k), tau_v, to_eye, source,
-                   clamps);
+    add_star_light<kChordPhase>(s, s.stars[k].position, s.stars[k].power, depth_of(k), irradiance_of(k), tau_v,
+                                to_eye, source, clamps);
+}
+
+// Whether a ray from `origin` along unit `dir` passes within
+// s.near_star_radius of a star: only such rays have chords whose angles
+// chord_phase_mean averages, so the others take the marcher without it (its
+// kernel keeps its registers) and give the same image.
+NEBULA_HD bool passes_near_a_star(const MarchScene& s, Vec3 origin, Vec3 dir) {
+  const float r2 = s.near_star_radius * s.near_star_radius;
+  for (int k = 0; k < s.n_stars; ++k) {
+    const Vec3 to_star = s.stars[k].position - origin;
+    const Vec3 off = to_star - fmaxf(dot(to_star, dir), 0.0f) * dir;
+    if (dot(off, off) < r2) return true;
+  }
+  return false;
 }
 
 // A cell-centred field at `pos`: trilinear (clamped at the grid's edge) or
@@ -162,11 +225,15 @@ struct MarchMode {
 // kVoxelSources: the preview, each voxel's light read from s.voxel_source
 // (exact traversal only). kZonal: the field has zonal degrees (its peak
 // blends towards the zonal response, DiffuseView::zonal_weight); without
-// them the kernel carries none of that code.
-template <bool kSmooth, bool kDiffuse, bool kVoxelSources = false, bool kZonal = false>
+// them the kernel carries none of that code. kChordPhase: the star's phase
+// averaged over a chord's angles near the star (the exact traversal; the
+// rays that need it are those passes_near_a_star picks. The smooth mode with
+// voxel values always averages, over the voxel's chord).
+template <bool kSmooth, bool kDiffuse, bool kVoxelSources = false, bool kZonal = false, bool kChordPhase = false>
 NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchMode mode) {
   static_assert(!(kSmooth && kVoxelSources), "the preview's voxel sources go with the exact traversal");
   static_assert(kDiffuse || !kZonal, "zonal degrees belong to a diffuse field");
+  static_assert(!kChordPhase || !(kSmooth || kVoxelSources), "the chord's angles belong to the exact traversal");
   RayResult out{};
   for (int b = 0; b < kMaxBands; ++b) out.transmittance[b] = 1.0f;
   const GridShape& g = s.density.shape;
@@ -195,14 +262,14 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchM
         const float ts = t_enter + (k + 0.5f) * step;
         if (ts >= t + chord || ts >= t_exit) break;
         // Trilinear fields are smooth, so is their geometry; voxel values keep
-        // the chord's geometry (its starlight over the chord), as the exact
-        // traversal does.
+        // the chord's geometry (its starlight over the chord, the phase
+        // averaged over its angles near a star), as the exact traversal does.
         const Vec3 pos = mode.trilinear ? origin + ts * dir : origin + (t + 0.5f * chord) * dir;
         float local[kMaxBands] = {};
         for (int b = 0; b < s.n_bands; ++b)
           local[b] = s.emission[b] ? sample_field(g, s.emission[b], pos, mode.trilinear) : 0.0f;
         const float tau_sample = sample_field(g, s.density.tau_v, pos, mode.trilinear);
-        scattered_source(
+        scattered_source</*kChordPhase=*/true>(  // (a point's irradiance has no angle span)
             s, tau_sample, to_eye,
             [&](int k_star) {
               const Vec3 star = s.stars[k_star].position;
@@ -241,7 +308,7 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchM
       for (int b = 0; b < kMaxBands; ++b)
         if (b < s.n_bands) source[b] = s.emission[b] ? s.emission[b][cell] : 0.0f;
       if (tau_v > 0.0f && s.n_stars > 0) {
-        scattered_source(
+        scattered_source<kChordPhase>(
             s, tau_v, to_eye,
             [&](int k_star) { return chord_irradiance(origin, dir, t, t + chord, s.stars[k_star].position, s.footprint); },
             [&](int k_star) { return s.stars[k_star].depth_v[cell]; }, source, &out.table_clamps);

@@ -91,13 +91,18 @@ Image render_cpu(const RenderInputs& in, RenderStats* stats) {
     });
   }
   dispatch_march(scene, in.mode, [&](auto smooth, auto diffuse, auto voxel_sources, auto zonal) {
+    constexpr bool exact = !smooth() && !voxel_sources();
     tbb::parallel_for(tbb::blocked_range<int>(0, in.camera.height), [&](const auto& rows) {
       uint64_t local_clamps = 0;
       for (int y = rows.begin(); y != rows.end(); ++y)
         for (int x = 0; x < in.camera.width; ++x) {
           Vec3 origin, dir;
           if (!in.camera.ray(x, y, origin, dir)) continue;
-          const RayResult r = march_ray<smooth(), diffuse(), voxel_sources(), zonal()>(scene, origin, dir, in.mode);
+          // Rays near a star average its phase over their chords' angles (ray_march.h).
+          const RayResult r =
+              exact && passes_near_a_star(scene, origin, dir)
+                  ? march_ray<smooth(), diffuse(), voxel_sources(), zonal(), exact>(scene, origin, dir, in.mode)
+                  : march_ray<smooth(), diffuse(), voxel_sources(), zonal()>(scene, origin, dir, in.mode);
           store_radiance(r, scene.n_bands, in.exposure, image.pixels.data(), image.width, image.height, x, y);
           local_clamps += r.table_clamps;
         }

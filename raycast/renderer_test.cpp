@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/philox.h"
+#include "core/placement.h"
 #include "raycast/test_scenes.h"
 
 namespace nebula {
@@ -101,6 +102,82 @@ TEST(Renderer, ThinSphereProfileForwardScattering) { expect_thin_sphere_profile(
 // A backlight (an emitting layer at the far side) seen through a uniform
 // slab dims by exp(-tau_b) per band, exactly: the marcher applies each
 // voxel's extinction after its own contribution.
+// A chord passing the star within a fraction of its length sees the star
+// under nearly every scattering angle: its single-scattered light, the mean
+// over the chord of P(tau, theta(s)) / r(s)^2 by quadrature of the table's own
+// lookup, against add_star_light's chord mean of 1 / r^2 times P averaged over
+// the chord's angles. One angle for the whole chord (its half-light point, 90
+// degrees here) is far off at g = 0.6, which the test checks too.
+TEST(Renderer, AChordBesideTheStarAveragesThePhaseOverItsAngles) {
+  const ScatteringTable table = thin_table(0.6);
+  MarchScene scene{};
+  scene.n_bands = 1;
+  scene.extinction_ratio[0] = 1.0f;
+  scene.albedo[0] = 1.0f;
+  HostPlacement host;
+  scene.table[0] = place_table(table, host);
+  const TableView& p = scene.table[0];
+  const Vec3 star{0, 0, 0}, dir{0, 0, 1}, to_eye = -dir;
+  const float power[kMaxBands] = {float(4 * kPiD)};  // E = 1 / r^2
+  const float tau_v = 1e-3f;
+  for (const float b : {0.002f, 0.01f, 0.05f}) {
+    const Vec3 origin{b, 0, -5};
+    const float t0 = 4.9f, t1 = 5.1f;  // the closest approach at t = 5
+    const ChordIrradiance at = chord_irradiance(origin, dir, t0, t1, star, RayFootprint{});
+    float source[kMaxBands] = {}, midpoint[kMaxBands] = {};
+    int clamps = 0;
+    add_star_light<true>(scene, star, power, 0.0f, at, tau_v, to_eye, source, &clamps);
+    add_star_light<false>(scene, star, power, 0.0f, at, tau_v, to_eye, midpoint, &clamps);
+    const int n = 200000;
+    double want = 0;
+    for (int i = 0; i < n; ++i) {
+      const double t = t0 + (i + 0.5) * (t1 - t0) / n, s = t - 5.0, r2 = double(b) * b + s * s;
+      want += p.lookup(tau_v, float(-s / std::sqrt(r2))) / r2;
+    }
+    want /= n;
+    EXPECT_NEAR(source[0] / want, 1.0, 0.01) << "b = " << b;
+    EXPECT_GT(std::fabs(midpoint[0] / want - 1.0), 0.2) << "b = " << b;
+    EXPECT_EQ(clamps, 0);
+  }
+}
+
+// The rays passes_near_a_star leaves out have no chord (of at most a voxel's
+// diagonal) that chord_phase_mean would average: the CPU loop and the CUDA
+// launch split the rays there without changing the image.
+TEST(Renderer, RaysFarFromEveryStarKeepTheHalfLightPoint) {
+  const float l = 0.05f;
+  const int n_mu = 72;
+  TableView table;
+  table.n_mu = n_mu;
+  table.bins = {AngularBinning::UniformTheta, n_mu};
+  MarchScene scene{};
+  StarView star{};
+  star.position = {0.3f, -0.2f, 0.1f};
+  scene.stars = &star;
+  scene.n_stars = 1;
+  scene.near_star_radius = chord_phase_radius(std::sqrt(3.0f) * l, n_mu);
+  UniformStream rng(7, 0, 0, 0);
+  int far = 0, near_averaged = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const Vec3 origin{4 * rng.next() - 2, 4 * rng.next() - 2, 4 * rng.next() - 2};
+    Vec3 dir{rng.next() - 0.5f, rng.next() - 0.5f, rng.next() - 0.5f};
+    dir = normalize(dir);
+    // A chord on the ray near its closest approach to the star (or its start).
+    const float tc = fmaxf(dot(star.position - origin, dir), 0.0f);
+    const float t0 = fmaxf(tc + (rng.next() - 0.5f) * 4 * l, 0.0f), t1 = t0 + std::sqrt(3.0f) * l * rng.next();
+    const ChordIrradiance at = chord_irradiance(origin, dir, t0, t1, star.position, RayFootprint{});
+    const bool mean = chord_takes_phase_mean(table, at.a0, at.a1);
+    if (!passes_near_a_star(scene, origin, dir)) {
+      ++far;
+      ASSERT_FALSE(mean) << "ray " << i;
+    } else if (mean) {
+      ++near_averaged;
+    }
+  }
+  EXPECT_GT(far, 1000);
+  EXPECT_GT(near_averaged, 1000);
+}
+
 TEST(Renderer, PureExtinctionThroughASlab) {
   DensityGrid grid = cube(8, 4.0f);
   const GridShape& g = grid.shape;

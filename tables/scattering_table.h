@@ -47,6 +47,8 @@ struct ScatteringTable {
   // a copy of the table starts without one). P does not change once a
   // renderer reads it.
   mutable DeviceMirror device_P;
+  // The device copy of cumulative_rows(*this) (tables/table_lookup.h).
+  mutable DeviceMirror device_C;
   std::vector<float> P_stderr;
   std::vector<double> total;
   std::vector<double> total_stderr;

@@ -7,6 +7,21 @@
 
 namespace nebula {
 
+std::vector<float> cumulative_rows(const ScatteringTable& table) {
+  const int n_tau = table.n_tau(), n_mu = table.n_mu();
+  std::vector<float> c(table.P.size());
+  if (table.P.size() != size_t(n_tau) * n_mu) return c;  // view_of refuses such a table
+  for (int i = 0; i < n_tau; ++i) {
+    const float* p = table.P.data() + table.index(i, 0);
+    double sum = 0.5 * p[0];
+    for (int k = 0; k < n_mu; ++k) {
+      if (k > 0) sum += 0.5 * (double(p[k - 1]) + p[k]);
+      c[table.index(i, k)] = float(sum);
+    }
+  }
+  return c;
+}
+
 TableView view_of(const ScatteringTable& table) {
   const size_t cells = static_cast<size_t>(table.n_tau()) * table.n_mu();
   if (table.n_tau() < 2 || table.n_mu() < 1 || table.P.size() != cells)

@@ -35,6 +35,7 @@ TEST(TableLookup, ViewOfCopiesTheShape) {
   const ScatteringTable t = make_test_table(5.0, 11, AngularBinning::UniformTheta, 36);
   const TableView v = view_of(t);
   EXPECT_EQ(v.P, t.P.data());
+  EXPECT_EQ(v.C, nullptr);  // the cumulative rows come with a placed view
   EXPECT_EQ(v.n_tau, 11);
   EXPECT_EQ(v.n_mu, 36);
   EXPECT_EQ(v.tau_max, 5.0f);
@@ -49,9 +50,43 @@ TEST(TableLookup, PlacedViewKeepsTheShape) {
   HostPlacement host;
   const TableView v = place_table(t, host);
   EXPECT_EQ(v.P, t.P.data());
+  EXPECT_NE(v.C, nullptr);
   EXPECT_EQ(v.n_tau, 11);
   EXPECT_EQ(v.n_mu, 36);
   EXPECT_EQ(host.bytes(), t.P.size() * sizeof(float));
+}
+
+// The mean over an interval of bin coordinates, from the cumulative rows in
+// O(1), against a fine midpoint quadrature of the lookup itself: intervals
+// inside, across the outermost centres and up to the domain's ends, at tau
+// on and between rows; a tau beyond the table is clamped and counted once.
+TEST(TableLookup, MeanOverAnglesIsTheMeanOfTheLookup) {
+  const ScatteringTable t = make_test_table(5.0, 11, AngularBinning::UniformTheta, 36, 0.9);
+  HostPlacement host;
+  const TableView v = place_table(t, host);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u_of(-0.5f, 35.5f), tau_of(0.0f, 5.0f);
+  double worst = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    float u0 = u_of(rng), u1 = u_of(rng);
+    if (trial % 10 == 0) u0 = -0.5f;
+    if (trial % 10 == 1) u1 = 35.5f;
+    if (u0 > u1) std::swap(u0, u1);
+    if (u1 - u0 < 1e-2f) continue;
+    const float tau = trial % 3 == 0 ? 1.5f : tau_of(rng);
+    const int n = 20000;
+    double want = 0;
+    for (int i = 0; i < n; ++i) want += v.lookup_at(tau, u0 + (i + 0.5f) * (u1 - u0) / n);
+    want /= n;
+    int clamped = 0;
+    const double got = v.mean_over_angles(tau, u0, u1, &clamped);
+    EXPECT_EQ(clamped, 0);
+    worst = std::max(worst, std::fabs(got / want - 1));
+  }
+  EXPECT_LT(worst, 1e-4);
+  int clamped = 0;
+  EXPECT_NEAR(v.mean_over_angles(9.0f, 3.0f, 7.0f, &clamped), v.mean_over_angles(5.0f, 3.0f, 7.0f), 1e-6);
+  EXPECT_EQ(clamped, 1);
 }
 
 TEST(TableLookup, ViewOfRefusesAMisshapenTable) {

@@ -40,10 +40,6 @@ import time
 
 import h5py
 import numpy as np
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENES = ["thin_nebula", "thick_nebula", "layer_front", "layer_behind", "wedge"]
@@ -241,6 +237,12 @@ def short_count(n):
 
 
 def plot(rows, images, backend):
+    # Imported here: the study scripts that borrow this module's grids need no plotting.
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
     os.makedirs(images, exist_ok=True)
     # method: (matplotlib format, colour, marker size, point labels). Sweeps over one knob are joined by a line.
     styles = {
