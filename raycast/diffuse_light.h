@@ -44,8 +44,12 @@ NEBULA_HD void voxel_diffuse_light(const MarchScene& s, const Camera& camera, in
       // its Legendre polynomials by Bonnet's recursion; blended with the
       // harmonics' own response by w.
       const int n_zonal = f.zonal - kDeg;
+      // The loops over zonal stars are unrolled to kMaxZonalStars on the
+      // device, so these arrays stay in registers.
       float mu[kMaxZonalStars], p_prev[kMaxZonalStars], p_l[kMaxZonalStars];
-      for (int k = 0; k < f.zonal_stars; ++k) {
+      NEBULA_UNROLL
+      for (int k = 0; k < kMaxZonalStars; ++k) {
+        if (k >= f.zonal_stars) break;
         const Vec3 r = centre - f.zonal_star[k];
         const float len = length(r);
         mu[k] = len > 0.0f ? dot(to_eye, r) / len : to_eye.z;
@@ -73,7 +77,9 @@ NEBULA_HD void voxel_diffuse_light(const MarchScene& s, const Camera& camera, in
       for (int l = kDeg + 1; l <= f.zonal; ++l) {
         const float norm = sqrtf((2.0f * l + 1.0f) * 0.07957747154594767f);  // sqrt((2l + 1) / (4 pi))
         float Dl[kMaxBands] = {};
-        for (int k = 0; k < f.zonal_stars; ++k) {
+        NEBULA_UNROLL
+        for (int k = 0; k < kMaxZonalStars; ++k) {
+          if (k >= f.zonal_stars) break;
           const float next = ((2.0f * l - 1.0f) * mu[k] * p_l[k] - float(l - 1) * p_prev[k]) / float(l);
           p_prev[k] = p_l[k];
           p_l[k] = next;

@@ -30,10 +30,20 @@ namespace {
 #define NEBULA_RENDER_MIN_BLOCKS 4
 #endif
 
+// Blocks of 256 threads per SM for the field's per-voxel light: 4 holds it to
+// 64 registers. With zonal degrees the compiler took 128 (22% occupancy,
+// latency-bound): the 1080p frame with them went 8.91-8.93 ms -> 8.40-8.41 ms
+// (H100; 3, 5, 6 and 8 blocks: 8.53, 8.76, 9.14 and 10.36 ms); without zonal
+// degrees the frame did not change (docs/performance.md).
+#ifndef NEBULA_DIFFUSE_LIGHT_MIN_BLOCKS
+#define NEBULA_DIFFUSE_LIGHT_MIN_BLOCKS 4
+#endif
+
 // One thread per voxel: the diffuse field's light towards this view's eye
 // (raycast/diffuse_light.h).
 template <int kDeg, bool kZonal>
-__global__ void diffuse_light_kernel(MarchScene scene, Camera camera, DiffuseLightPlanes out) {
+__global__ void __launch_bounds__(256, NEBULA_DIFFUSE_LIGHT_MIN_BLOCKS)
+    diffuse_light_kernel(MarchScene scene, Camera camera, DiffuseLightPlanes out) {
   const GridShape& g = scene.density.shape;
   const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i >= g.count()) return;
