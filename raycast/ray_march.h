@@ -42,6 +42,9 @@ struct MarchScene {
   // (null where the band has no field): raycast/diffuse_light.h fills it
   // before the march.
   const float* diffuse_light[kMaxBands] = {};
+  // Its forward peak per voxel and band, filled with it: the exact traversal
+  // reads it instead of looking the response up at every crossing.
+  const float* diffuse_peak[kMaxBands] = {};
   // The preview (MarchMode::voxel_sources): all the light each voxel sends
   // towards this view's eye, per band, filled before the march by
   // raycast/voxel_sources.h; the march then only carries it to the eye.
@@ -221,11 +224,12 @@ struct MarchMode {
 // the voxel's chord over samples of the interpolated fields inside it.
 // kDiffuse: the scene has a diffuse field, its light per voxel already
 // evaluated for this view (raycast/diffuse_light.h): it adds to the voxel's
-// source as emission does, and its forward peak to the voxel's transmittance.
-// kVoxelSources: the preview, each voxel's light read from s.voxel_source
-// (exact traversal only). kZonal: the field has zonal degrees (its peak
-// blends towards the zonal response, DiffuseView::zonal_weight); without
-// them the kernel carries none of that code. kChordPhase: the star's phase
+// source as emission does, and its forward peak to the voxel's transmittance
+// (the exact traversal reads the peak evaluated with the light; the smooth
+// mode and the preview look it up). kVoxelSources: the preview, each voxel's
+// light read from s.voxel_source (exact traversal only). kZonal: the field
+// has zonal degrees (the looked-up peak blends towards the zonal response,
+// DiffuseView::zonal_weight); without them the kernel carries none of that code. kChordPhase: the star's phase
 // averaged over a chord's angles near the star (the exact traversal; the
 // rays that need it are those passes_near_a_star picks. The smooth mode with
 // voxel values always averages, over the voxel's chord).
@@ -314,15 +318,14 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchM
             [&](int k_star) { return s.stars[k_star].depth_v[cell]; }, source, &out.table_clamps);
       }
       if constexpr (kDiffuse) {
+        // The voxel's light and forward peak for this view (the peak blended
+        // with the zonal response's as the light is; raycast/diffuse_light.h).
         if (tau_v > 0.0f) {
-          // The zonal response's weight (0 without zonal degrees): its peak
-          // blends with the harmonics' own as the per-view light did.
-          const float w = zonal_weight(origin + (t + 0.5f * chord) * dir);
           NEBULA_UNROLL
           for (int b = 0; b < kMaxBands; ++b)
             if (b < s.n_bands && s.diffuse_light[b]) {
               source[b] += s.diffuse_light[b][cell];
-              peak[b] = s.diffuse.peak(b, s.albedo[b] * tau_v * s.extinction_ratio[b], w);
+              peak[b] = s.diffuse_peak[b][cell];
             }
         }
       }

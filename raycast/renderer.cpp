@@ -52,7 +52,7 @@ Image render_cpu(const RenderInputs& in, RenderStats* stats) {
   Image image(in.camera.width, in.camera.height, band_names(in.bands));
   std::atomic<uint64_t> clamps{0};
   const auto start = std::chrono::steady_clock::now();
-  std::vector<std::vector<float>> light(kMaxBands);
+  std::vector<std::vector<float>> light(kMaxBands), peak(kMaxBands);
   if (in.mode.voxel_sources) {
     // The preview: every voxel's light towards the eye, once (raycast/voxel_sources.h).
     const GridShape& g = scene.density.shape;
@@ -78,8 +78,11 @@ Image render_cpu(const RenderInputs& in, RenderStats* stats) {
     for (int b = 0; b < scene.n_bands; ++b)
       if (scene.diffuse.has[b]) {
         light[b].assign(g.count(), 0.0f);
+        peak[b].assign(g.count(), 0.0f);
         planes.band[b] = light[b].data();
+        planes.peak[b] = peak[b].data();
         scene.diffuse_light[b] = planes.band[b];
+        scene.diffuse_peak[b] = planes.peak[b];
       }
     dispatch_diffuse_degree(scene.diffuse.degree, [&](auto degree) {
       dispatch_zonal(scene, [&](auto zonal) {

@@ -34,15 +34,19 @@ namespace {
 // 64 registers. With zonal degrees the compiler took 128 (22% occupancy,
 // latency-bound): the 1080p frame with them went 8.91-8.93 ms -> 8.40-8.41 ms
 // (H100; 3, 5, 6 and 8 blocks: 8.53, 8.76, 9.14 and 10.36 ms); without zonal
-// degrees the frame did not change (docs/performance.md).
+// degrees the frame did not change (docs/performance.md). The zonal kernel
+// has its own bound, measured apart.
 #ifndef NEBULA_DIFFUSE_LIGHT_MIN_BLOCKS
 #define NEBULA_DIFFUSE_LIGHT_MIN_BLOCKS 4
+#endif
+#ifndef NEBULA_DIFFUSE_ZONAL_MIN_BLOCKS
+#define NEBULA_DIFFUSE_ZONAL_MIN_BLOCKS 4
 #endif
 
 // One thread per voxel: the diffuse field's light towards this view's eye
 // (raycast/diffuse_light.h).
 template <int kDeg, bool kZonal>
-__global__ void __launch_bounds__(256, NEBULA_DIFFUSE_LIGHT_MIN_BLOCKS)
+__global__ void __launch_bounds__(256, kZonal ? NEBULA_DIFFUSE_ZONAL_MIN_BLOCKS : NEBULA_DIFFUSE_LIGHT_MIN_BLOCKS)
     diffuse_light_kernel(MarchScene scene, Camera camera, DiffuseLightPlanes out) {
   const GridShape& g = scene.density.shape;
   const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
@@ -158,7 +162,7 @@ struct SideStream {
   }
 };
 struct FrameBuffers {
-  std::unique_ptr<DeviceArray<float>> pixels, light[kMaxBands];
+  std::unique_ptr<DeviceArray<float>> pixels, light[kMaxBands], peak[kMaxBands];
   std::unique_ptr<DeviceArray<unsigned long long>> clamps;
   PinnedStaging staging;
   SideStream near;
@@ -194,7 +198,9 @@ double render_cuda_to_device(const RenderInputs& in, float* pixels, unsigned lon
     for (int b = 0; b < scene.n_bands; ++b)
       if (scene.diffuse.has[b]) {
         planes.band[b] = reused(frame_buffers.light[b], count);
+        planes.peak[b] = reused(frame_buffers.peak[b], count);
         scene.diffuse_light[b] = planes.band[b];
+        scene.diffuse_peak[b] = planes.peak[b];
       }
     dispatch_diffuse_degree(scene.diffuse.degree, [&](auto degree) {
       dispatch_zonal(scene, [&](auto zonal) {

@@ -36,8 +36,8 @@ NEBULA_HD void voxel_source(const MarchScene& s, const Camera& camera, int x, in
     add_star_light(s, s.stars[k].position, s.stars[k].power, s.stars[k].depth_v[cell],
                    point_irradiance(centre, s.stars[k].position, g.voxel), tau_v, to_eye, out, clamps);
   if constexpr (kDeg >= 0) {
-    float light[kMaxBands];
-    voxel_diffuse_light<kDeg, kZonal>(s, camera, x, y, z, light);
+    float light[kMaxBands], peak[kMaxBands];  // (the march looks the peak up per crossing)
+    voxel_diffuse_light<kDeg, kZonal>(s, camera, x, y, z, light, peak);
     NEBULA_UNROLL
     for (int b = 0; b < kMaxBands; ++b)
       if (b < s.n_bands) out[b] += light[b];
