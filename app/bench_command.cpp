@@ -143,7 +143,7 @@ void add_render(CLI::App* bench) {
 
 void add_diffuse(CLI::App* bench) {
   struct Options : Common {
-    int size = 256, width = 1920, height = 1080, degree = DiffuseBakeOptions{}.degree, cells = 64, zonal = 0;
+    int size = 256, width = 1920, height = 1080, degree = -1, cells = 64, zonal = 0;  // degree -1: as "auto"
     std::string photons = "1048576";
   };
   auto o = std::make_shared<Options>();
@@ -153,12 +153,14 @@ void add_diffuse(CLI::App* bench) {
                             *o);
   add_size(cmd, o->size, 2);
   add_frame(cmd, o->width, o->height);
-  cmd->add_option("--order", o->degree, "harmonics' degree")->capture_default_str()->check(CLI::Range(0, kMaxDiffuseDegree));
+  cmd->add_option("--order", o->degree, "harmonics' degree (default: 4, or 3 with --zonal, as a scene's \"auto\")")
+      ->check(CLI::Range(0, kMaxDiffuseDegree));
   cmd->add_option("--zonal", o->zonal, "zonal degrees of the star's light (0: none)")->capture_default_str()->check(CLI::Range(0, kMaxZonalDegree));
   cmd->add_option("--cells", o->cells, "field cells along the grid's edge (at least)")->capture_default_str()->check(CLI::Range(1, 4096));
   cmd->add_option("--photons", o->photons, "photons per band")->capture_default_str();
   cmd->callback([o] {
     const uint64_t photons = parse_count("--photons", o->photons, 1, 4294967295.0);
+    if (o->degree < 0) o->degree = o->zonal > 0 ? 3 : 4;  // scene/scene.cpp, resolved_order
     std::printf("| backend | grid | field cells | order | photons/band | star bake ms | photon passes ms | diffuse bake "
                 "ms (end to end) | frame ms without | frame ms with | field MiB | bake work MiB | star depth MiB | "
                 "noise (V, l = 0) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");

@@ -62,7 +62,7 @@ TEST_F(RenderScene, IsTheRenderersImageOnItsInputs) {
     diffuse_bands.push_back(d);
   }
   DiffuseBakeOptions diffuse;
-  diffuse.degree = s.diffuse.order;
+  diffuse.degree = resolved_order(s.diffuse, s.dust.g);
   diffuse.cells = s.diffuse.cells;
   diffuse.photons = s.diffuse.photons;
   diffuse.seed = s.diffuse.seed;

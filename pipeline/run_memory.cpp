@@ -22,7 +22,8 @@ RunMemory estimate_run_memory(const Scene& scene, RunKind kind) {
     m.parts.push_back({"the " + std::to_string(scene.samples_per_pixel) + " samples per pixel's finer image",
                        image * scene.samples_per_pixel});
   const double cells = double(scene.diffuse.cells);
-  const double coefficients = double((scene.diffuse.order + 1) * (scene.diffuse.order + 1));
+  const int order = resolved_order(scene.diffuse, scene.dust.g);
+  const double coefficients = double((order + 1) * (order + 1));
   if (scene.axial) {
     const AxialSpec& a = *scene.axial;
     if (a.source == "synthetic")
@@ -50,9 +51,9 @@ RunMemory estimate_run_memory(const Scene& scene, RunKind kind) {
         // Zonal degrees add theirs per zonal star (at most 4).
         const int zonal = resolved_zonal(scene.diffuse, scene.dust.g);
         const double zonal_coefficients =
-            zonal > scene.diffuse.order ? double(zonal - scene.diffuse.order) * double(std::min<size_t>(scene.stars.size(), 4)) : 0.0;
+            zonal > order ? double(zonal - order) * double(std::min<size_t>(scene.stars.size(), 4)) : 0.0;
         m.parts.push_back({"diffuse field", cells * cells * cells * (coefficients + zonal_coefficients) * bands * (4 * 2 + 8)});
-        m.parts.push_back({"diffuse light per view", voxels * 4 * bands});
+        m.parts.push_back({"diffuse light per view (light and forward peak)", voxels * 4 * 2 * bands});
       }
     } else {
       m.parts.push_back({"majorant grid", voxels * 4});

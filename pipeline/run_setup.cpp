@@ -207,7 +207,7 @@ std::vector<DiffuseBand> diffuse_bands(const SceneBands& bands, const BandTables
 
 DiffuseBakeOptions diffuse_options(const Scene& scene) {
   DiffuseBakeOptions options;
-  options.degree = scene.diffuse.order;
+  options.degree = resolved_order(scene.diffuse, scene.dust.g);
   options.zonal = resolved_zonal(scene.diffuse, scene.dust.g);
   options.cells = scene.diffuse.cells;
   options.photons = scene.diffuse.photons;

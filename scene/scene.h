@@ -98,7 +98,10 @@ bool parse_multiple_scattering(const std::string& name, MultipleScattering& out)
 
 // The diffuse field's settings ([render] diffuse_*, docs/scene.md).
 struct DiffuseSettings {
-  int order = 3;                 // harmonics' degree, 0 to 4
+  // Harmonics' degree, 0 to 4; kOrderAuto: 4, or 3 where zonal degrees carry
+  // the stars' light (resolved_order).
+  static constexpr int kOrderAuto = -1;
+  int order = kOrderAuto;
   int cells = 64;                // field cells along the grid's longest axis (at least)
   // Zonal degrees of the brightest stars' light (docs/diffuse.md): 0 none,
   // else order + 1 to 32; kZonalAuto: 24 when a band's g >= 0.8, else none.
@@ -110,6 +113,8 @@ struct DiffuseSettings {
 
 // The zonal degree a scene's field uses (resolving "auto" by the bands' g).
 int resolved_zonal(const DiffuseSettings& d, const std::vector<double>& g);
+// The harmonics' degree a scene's field uses (resolving "auto" likewise).
+int resolved_order(const DiffuseSettings& d, const std::vector<double>& g);
 
 // A filter read from a file the scene names ([filters] in a scene file): a
 // band like the built-in filters (illumination/filters.h).

@@ -809,7 +809,14 @@ void Parser::parse_render(const toml::table& root, Scene& scene) const {
       fail("render.multiple_scattering", "'" + mode + "' is not a mode (known: diffuse, pyramid, none)");
   }
   DiffuseSettings& d = scene.diffuse;
-  if (const toml::node* v = t.get("diffuse_order")) d.order = small_integer(*v, "render.diffuse_order");
+  if (const toml::node* v = t.get("diffuse_order")) {
+    if (v->is_string() && lower(string(*v, "render.diffuse_order")) == "auto")
+      d.order = DiffuseSettings::kOrderAuto;
+    else if (v->is_string())
+      fail("render.diffuse_order", "must be \"auto\" or a whole number, got '" + string(*v, "render.diffuse_order") + "'");
+    else if ((d.order = small_integer(*v, "render.diffuse_order")) < 0)  // (-1 is not "auto")
+      fail("render.diffuse_order", "is " + std::to_string(d.order) + "; must be \"auto\" or in 0..4");
+  }
   if (const toml::node* v = t.get("diffuse_zonal")) {
     if (v->is_string() && lower(string(*v, "render.diffuse_zonal")) == "auto")
       d.zonal = DiffuseSettings::kZonalAuto;

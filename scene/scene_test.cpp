@@ -403,6 +403,26 @@ TEST_F(SceneFile, DiffuseZonalIsAutoOrAWholeNumberAboveTheOrder) {
   refused("zonal_high", kBase + std::string("\n[render]\ndiffuse_zonal = 40\n"), {"render.diffuse_zonal", "at most 32"});
 }
 
+// render.diffuse_order: "auto" (the default: 4, or 3 where zonal degrees carry
+// the stars' light), or a whole number 0 to 4; anything else refused by name.
+TEST_F(SceneFile, DiffuseOrderIsAutoOrAWholeNumberUpToFour) {
+  const Scene base = load_scene(write_text("order_base.toml", kBase));
+  EXPECT_EQ(base.diffuse.order, DiffuseSettings::kOrderAuto);
+  EXPECT_EQ(resolved_order(base.diffuse, base.dust.g), 4) << "g = 0.6 in every band: no zonal degrees";
+  EXPECT_EQ(resolved_order(base.diffuse, {0.6, 0.85, 0.6}), 3) << "zonal degrees for strongly forward dust";
+  const Scene no_zonal = load_scene(write_text("order_nozonal.toml", kBase + std::string("\n[render]\ndiffuse_zonal = 0\n")));
+  EXPECT_EQ(resolved_order(no_zonal.diffuse, {0.9}), 4);
+  const Scene fixed = load_scene(write_text("order_2.toml", kBase + std::string("\n[render]\ndiffuse_order = 2\n")));
+  EXPECT_EQ(resolved_order(fixed.diffuse, {0.6}), 2);
+  EXPECT_EQ(resolved_order(fixed.diffuse, {0.9}), 2);
+  const Scene spelled = load_scene(write_text("order_auto.toml", kBase + std::string("\n[render]\ndiffuse_order = \"Auto\"\n")));
+  EXPECT_EQ(spelled.diffuse.order, DiffuseSettings::kOrderAuto);
+  refused("order_word", kBase + std::string("\n[render]\ndiffuse_order = \"high\"\n"), {"render.diffuse_order", "auto"});
+  refused("order_high", kBase + std::string("\n[render]\ndiffuse_order = 5\n"), {"render.diffuse_order", "0..4"});
+  refused("order_negative", kBase + std::string("\n[render]\ndiffuse_order = -2\n"), {"render.diffuse_order", "0..4"});
+  refused("order_minus_one", kBase + std::string("\n[render]\ndiffuse_order = -1\n"), {"render.diffuse_order", "0..4"});
+}
+
 TEST_F(SceneFile, RefusesBadCameras) {
   refused("zero_view", edited("look_at = [1.0, 1.0, 1.0]", "look_at = [1.0, -3.0, 1.0]"), {"camera.look_at", "zero length"});
   refused("up_parallel", edited("[camera]\n", "[camera]\nup = [0, 2, 0]\n"), {"camera.up", "parallel"});

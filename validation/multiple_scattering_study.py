@@ -33,7 +33,7 @@ METHODS = {
     "diffuse (default)": [],
     "diffuse harmonics only": ["--set", "render.diffuse_zonal=0"],
     "diffuse zonal 24 at every g": ["--set", "render.diffuse_zonal=24"],
-    "diffuse degree 4": ["--set", "render.diffuse_order=4"],
+    "diffuse degree 3": ["--set", "render.diffuse_order=3"],
     "pyramid 1 level": ["--levels", "1"],
     "pyramid 2 levels": ["--levels", "2"],
     "pyramid 3 levels": ["--levels", "3"],
