@@ -225,8 +225,8 @@ struct MarchMode {
 // kDiffuse: the scene has a diffuse field, its light per voxel already
 // evaluated for this view (raycast/diffuse_light.h): it adds to the voxel's
 // source as emission does, and its forward peak to the voxel's transmittance
-// (the exact traversal reads the peak evaluated with the light; the smooth
-// mode and the preview look it up). kVoxelSources: the preview, each voxel's
+// (the exact traversal and the preview read the peak evaluated with the
+// light; the smooth mode looks it up per sample). kVoxelSources: the preview, each voxel's
 // light read from s.voxel_source (exact traversal only). kZonal: the field
 // has zonal degrees (the looked-up peak blends towards the zonal response,
 // DiffuseView::zonal_weight); without them the kernel carries none of that code. kChordPhase: the star's phase
@@ -299,12 +299,11 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchM
       for (int b = 0; b < kMaxBands; ++b)
         if (b < s.n_bands) source[b] = s.voxel_source[b][cell];
       if constexpr (kDiffuse) {
+        // The field's forward peak, evaluated with the voxel's source.
         if (tau_v > 0.0f) {
-          const float w = zonal_weight(origin + (t + 0.5f * chord) * dir);
           NEBULA_UNROLL
           for (int b = 0; b < kMaxBands; ++b)
-            if (b < s.n_bands && s.diffuse.has[b])
-              peak[b] = s.diffuse.peak(b, s.albedo[b] * tau_v * s.extinction_ratio[b], w);
+            if (b < s.n_bands && s.diffuse_peak[b]) peak[b] = s.diffuse_peak[b][cell];
         }
       }
     } else {

@@ -61,6 +61,11 @@ Image render_cpu(const RenderInputs& in, RenderStats* stats) {
       light[b].resize(g.count());
       planes.band[b] = light[b].data();
       scene.voxel_source[b] = planes.band[b];
+      if (scene.has_diffuse && scene.diffuse.has[b]) {
+        peak[b].assign(g.count(), 0.0f);
+        planes.peak[b] = peak[b].data();
+        scene.diffuse_peak[b] = planes.peak[b];
+      }
     }
     dispatch_source_degree(scene, [&](auto degree) {
       dispatch_zonal(scene, [&](auto zonal) {

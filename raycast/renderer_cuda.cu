@@ -184,6 +184,10 @@ double render_cuda_to_device(const RenderInputs& in, float* pixels, unsigned lon
     for (int b = 0; b < scene.n_bands; ++b) {
       sources.band[b] = reused(frame_buffers.light[b], count);
       scene.voxel_source[b] = sources.band[b];
+      if (scene.has_diffuse && scene.diffuse.has[b]) {
+        sources.peak[b] = reused(frame_buffers.peak[b], count);
+        scene.diffuse_peak[b] = sources.peak[b];
+      }
     }
     dispatch_source_degree(scene, [&](auto degree) {
       dispatch_zonal(scene, [&](auto zonal) {

@@ -20,14 +20,18 @@ namespace nebula {
 
 // Voxel (x, y, z)'s light towards the eye per band, per unit of chord / l:
 // emission + sum over stars of E P(tau_sct, theta) + the diffuse field's
-// light (kDeg its degree; -1: no field). Table clamps are counted in *clamps.
+// light (kDeg its degree; -1: no field), and in `peak` the field's forward
+// peak (0 without a field). Table clamps are counted in *clamps.
 template <int kDeg, bool kZonal = false>
 NEBULA_HD void voxel_source(const MarchScene& s, const Camera& camera, int x, int y, int z, float (&out)[kMaxBands],
-                            int* clamps) {
+                            float (&peak)[kMaxBands], int* clamps) {
   const GridShape& g = s.density.shape;
   const size_t cell = g.index(x, y, z);
   NEBULA_UNROLL
-  for (int b = 0; b < kMaxBands; ++b) out[b] = (b < s.n_bands && s.emission[b]) ? s.emission[b][cell] : 0.0f;
+  for (int b = 0; b < kMaxBands; ++b) {
+    out[b] = (b < s.n_bands && s.emission[b]) ? s.emission[b][cell] : 0.0f;
+    peak[b] = 0.0f;
+  }
   const float tau_v = s.density.tau_v[cell];
   if (!(tau_v > 0.0f)) return;
   const Vec3 centre = g.origin + g.voxel * Vec3{x + 0.5f, y + 0.5f, z + 0.5f};
@@ -36,7 +40,7 @@ NEBULA_HD void voxel_source(const MarchScene& s, const Camera& camera, int x, in
     add_star_light(s, s.stars[k].position, s.stars[k].power, s.stars[k].depth_v[cell],
                    point_irradiance(centre, s.stars[k].position, g.voxel), tau_v, to_eye, out, clamps);
   if constexpr (kDeg >= 0) {
-    float light[kMaxBands], peak[kMaxBands];  // (the march looks the peak up per crossing)
+    float light[kMaxBands];
     voxel_diffuse_light<kDeg, kZonal>(s, camera, x, y, z, light, peak);
     NEBULA_UNROLL
     for (int b = 0; b < kMaxBands; ++b)
@@ -44,9 +48,11 @@ NEBULA_HD void voxel_source(const MarchScene& s, const Camera& camera, int x, in
   }
 }
 
-// Where the sources go: one array per band of the scene.
+// Where the sources go: one array per band of the scene; the field's forward
+// peak one per band with a field (null elsewhere).
 struct VoxelSourcePlanes {
   float* band[kMaxBands] = {};
+  float* peak[kMaxBands] = {};
 };
 
 // Voxels x_begin..x_end - 1 of row (y, z): the unit of work of the CPU loop
@@ -57,12 +63,14 @@ NEBULA_HD int voxel_source_row(const MarchScene& s, const Camera& camera, int y,
   const GridShape& g = s.density.shape;
   int clamps = 0;
   for (int x = x_begin; x < x_end; ++x) {
-    float source[kMaxBands];
-    voxel_source<kDeg, kZonal>(s, camera, x, y, z, source, &clamps);
+    float source[kMaxBands], peak[kMaxBands];
+    voxel_source<kDeg, kZonal>(s, camera, x, y, z, source, peak, &clamps);
     const size_t cell = g.index(x, y, z);
     NEBULA_UNROLL
-    for (int b = 0; b < kMaxBands; ++b)
+    for (int b = 0; b < kMaxBands; ++b) {
       if (b < s.n_bands) out.band[b][cell] = source[b];
+      if (out.peak[b]) out.peak[b][cell] = peak[b];
+    }
   }
   return clamps;
 }
