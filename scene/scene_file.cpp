@@ -822,8 +822,8 @@ void Parser::parse_render(const toml::table& root, Scene& scene) const {
       d.zonal = DiffuseSettings::kZonalAuto;
     else if (v->is_string())
       fail("render.diffuse_zonal", "must be \"auto\" or a whole number, got '" + string(*v, "render.diffuse_zonal") + "'");
-    else
-      d.zonal = small_integer(*v, "render.diffuse_zonal");
+    else if ((d.zonal = small_integer(*v, "render.diffuse_zonal")) < 0)  // (-1 is not "auto")
+      fail("render.diffuse_zonal", "is " + std::to_string(d.zonal) + "; must be \"auto\", 0 (none) or above render.diffuse_order, at most 32");
   }
   if (const toml::node* v = t.get("diffuse_cells")) d.cells = small_integer(*v, "render.diffuse_cells");
   auto count = [&](const char* name, uint64_t& out) {

@@ -401,6 +401,7 @@ TEST_F(SceneFile, DiffuseZonalIsAutoOrAWholeNumberAboveTheOrder) {
   refused("zonal_word", kBase + std::string("\n[render]\ndiffuse_zonal = \"many\"\n"), {"render.diffuse_zonal", "auto"});
   refused("zonal_low", kBase + std::string("\n[render]\ndiffuse_zonal = 3\n"), {"render.diffuse_zonal", "above render.diffuse_order"});
   refused("zonal_high", kBase + std::string("\n[render]\ndiffuse_zonal = 40\n"), {"render.diffuse_zonal", "at most 32"});
+  refused("zonal_minus_one", kBase + std::string("\n[render]\ndiffuse_zonal = -1\n"), {"render.diffuse_zonal", "\"auto\""});
 }
 
 // render.diffuse_order: "auto" (the default: 4, or 3 where zonal degrees carry
