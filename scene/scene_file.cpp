@@ -809,22 +809,22 @@ void Parser::parse_render(const toml::table& root, Scene& scene) const {
       fail("render.multiple_scattering", "'" + mode + "' is not a mode (known: diffuse, pyramid, none)");
   }
   DiffuseSettings& d = scene.diffuse;
-  if (const toml::node* v = t.get("diffuse_order")) {
-    if (v->is_string() && lower(string(*v, "render.diffuse_order")) == "auto")
-      d.order = DiffuseSettings::kOrderAuto;
+  // "auto" (any case) or a whole number >= 0; a negative number is refused
+  // rather than taken for the auto marker.
+  auto auto_or_count = [&](const char* name, int auto_value, const std::string& range, int& out) {
+    const toml::node* v = t.get(name);
+    if (!v) return;
+    const std::string key = std::string("render.") + name;
+    if (v->is_string() && lower(string(*v, key)) == "auto")
+      out = auto_value;
     else if (v->is_string())
-      fail("render.diffuse_order", "must be \"auto\" or a whole number, got '" + string(*v, "render.diffuse_order") + "'");
-    else if ((d.order = small_integer(*v, "render.diffuse_order")) < 0)  // (-1 is not "auto")
-      fail("render.diffuse_order", "is " + std::to_string(d.order) + "; must be \"auto\" or in 0..4");
-  }
-  if (const toml::node* v = t.get("diffuse_zonal")) {
-    if (v->is_string() && lower(string(*v, "render.diffuse_zonal")) == "auto")
-      d.zonal = DiffuseSettings::kZonalAuto;
-    else if (v->is_string())
-      fail("render.diffuse_zonal", "must be \"auto\" or a whole number, got '" + string(*v, "render.diffuse_zonal") + "'");
-    else if ((d.zonal = small_integer(*v, "render.diffuse_zonal")) < 0)  // (-1 is not "auto")
-      fail("render.diffuse_zonal", "is " + std::to_string(d.zonal) + "; must be \"auto\", 0 (none) or above render.diffuse_order, at most 32");
-  }
+      fail(key, "must be \"auto\" or a whole number, got '" + string(*v, key) + "'");
+    else if ((out = small_integer(*v, key)) < 0)
+      fail(key, "is " + std::to_string(out) + "; must be " + range);
+  };
+  auto_or_count("diffuse_order", DiffuseSettings::kOrderAuto, "\"auto\" or in 0..4", d.order);
+  auto_or_count("diffuse_zonal", DiffuseSettings::kZonalAuto,
+                "\"auto\", 0 (none) or above render.diffuse_order, at most 32", d.zonal);
   if (const toml::node* v = t.get("diffuse_cells")) d.cells = small_integer(*v, "render.diffuse_cells");
   auto count = [&](const char* name, uint64_t& out) {
     const toml::node* v = t.get(name);
