@@ -1,14 +1,19 @@
 #pragma once
 // The spectral ray marcher (Barrès 2023, Algorithms 3-5, on our grids): the
 // exact voxel traversal of the band renderer, each voxel scattering each
-// star's light once toward the eye (Henyey-Greenstein, constant albedo a and
-// g; the voxel's own extinction left out, DESIGN.md "Ray marching"), with
-// the extinction spectral: tau(lambda) = tau_V kappa(lambda). Along a ray
-// every voxel-star pair carries a weight w (the star's luminosity, the mean
-// 1/r^2 over the chord, a tau_V p_HG(theta) c/l) and one number, its V-band
-// optical path D = (star to voxel) + (voxel to eye); its light through filter
-// f is w * integral S_f(lambda) kappa(lambda) s_star(lambda) e^(-kappa D) dlambda.
-// Four ways to take that integral, all accumulating a few numbers per ray:
+// star's light toward the eye (Henyey-Greenstein, constant albedo a and g; the
+// voxel's own extinction left out, DESIGN.md "Ray marching"), with the
+// extinction spectral: tau(lambda) = tau_V kappa(lambda). Along a ray every
+// voxel-star pair carries a weight w (the star's luminosity, the mean 1/r^2
+// over the chord, a tau_V p_HG(theta) c/l) and one number, its V-band optical
+// path D = (star to voxel) + (voxel to eye); in the thin-voxel limit its light
+// through filter f is w * integral S_f(lambda) kappa(lambda) s_star(lambda)
+// e^(-kappa D) dlambda. With the voxel's scattering table (multiple scattering
+// inside it) P(a tau_V kappa, theta) replaces a tau_V kappa p_HG: read at a few
+// attenuations and taken as a polynomial in kappa between them, each power of
+// kappa one more term of the same form (SpectralSceneView::n_nodes,
+// pair_weights; docs/spectral.md, "Tables").
+// Five ways to take that integral, all accumulating a few numbers per ray:
 //   Double:     M wavelengths per pair (the report's double numerical integral);
 //   Analytic:   the closed form of polynomial x e^(-a/lambda) (Algorithm 1) per
 //               pair and filter (kappa = C_T / lambda only);
@@ -42,6 +47,7 @@
 #include "core/math.h"
 #include "illumination/chord_irradiance.h"
 #include "spectral/expint.h"
+#include "tables/table_lookup.h"
 
 namespace nebula::spectral {
 
@@ -50,6 +56,7 @@ enum class SpectralMethod { Double, Analytic, Projection, LightBasis, VoxelLight
 constexpr int kMaxAccumulators = 64;  // per ray: registers on the GPU
 constexpr int kMaxBasis = 16;
 constexpr int kMaxVoxelLightStars = 32;  // VoxelLight: one bit per star in a voxel's near-star mask
+constexpr int kMaxTableNodes = 4;        // attenuations at which a pair reads the table
 
 struct SpectralStarView {
   Vec3 position;
@@ -89,12 +96,64 @@ struct SpectralSceneView {
   const float* voxel_light = nullptr;
   const unsigned* near_stars = nullptr;
   float near_distance = 0;
+  // The voxel's scattering table (docs/spectral.md, "Tables"). n_nodes = 0: the
+  // thin-voxel limit P = tau_sct p_HG. Else P(a tau_V kappa, mu), which holds the
+  // multiple scattering inside the voxel, is read at the attenuations
+  // node_kappa[m], and P / kappa is interpolated in kappa by the polynomial
+  // sum_p B_p kappa^p through them (B_p = sum_m node_to_power[p][m] P_m /
+  // kappa_m): the pair's light is then sum_p B_p integral S_f kappa^(p+1) s
+  // e^(-kappa D) dlambda, and each power p has its own block of the coefficient
+  // tables (coeff, star_coeff: n_powers blocks, the model's). Double reads P at
+  // each of its wavelengths instead (the reference the nodes are measured against).
+  TableView table;
+  int n_nodes = 0;
+  int n_powers = 1;
+  float node_kappa[kMaxTableNodes] = {};
+  float node_to_power[kMaxTableNodes * kMaxTableNodes] = {};
 };
 
 // Henyey-Greenstein phase function per steradian.
 NEBULA_HD float hg_phase(float mu, float g) {
   const float d = 1.0f + g * g - 2.0f * g * mu;
   return (1.0f - g * g) * kInv4Pi / (d * sqrtf(d));
+}
+
+// One voxel-star pair's weights on the powers of kappa: its light through
+// filter f is sum_p b[p] integral S_f kappa^(p+1) s e^(-kappa D) dlambda. w is
+// the thin-limit weight L/(4 pi) <1/r^2> a tau_V p_HG(mu) c/l: alone (b[0] = w)
+// without a table; with one, scale = w / (a tau_V p_HG) turns P(tau_sct, u) into
+// the pair's weight at an attenuation (Double's exact lookups use it too).
+struct PairWeights {
+  float b[kMaxTableNodes];
+  int n;
+  float scale, tau_sct, u;  // tables: w / (a tau_V p_HG), a tau_V, the table's angle coordinate
+};
+NEBULA_HD PairWeights pair_weights(const SpectralSceneView& s, float w, float tau_v, float mu) {
+  PairWeights p;
+  p.b[0] = w;
+  p.n = 1;
+  p.scale = 0.0f;
+  p.tau_sct = s.albedo * tau_v;
+  p.u = 0.0f;
+  if (s.n_nodes == 0) return p;
+  const float thin = p.tau_sct * hg_phase(mu, s.g);
+  p.scale = thin > 0.0f ? w / thin : 0.0f;
+  p.u = s.table.angle_coordinate(mu);
+  float node[kMaxTableNodes];
+  NEBULA_UNROLL
+  for (int m = 0; m < kMaxTableNodes; ++m)
+    if (m < s.n_nodes) node[m] = p.scale * s.table.lookup_at(p.tau_sct * s.node_kappa[m], p.u) / s.node_kappa[m];
+  NEBULA_UNROLL
+  for (int q = 0; q < kMaxTableNodes; ++q) {
+    if (q >= s.n_nodes) break;
+    float sum = 0.0f;
+    NEBULA_UNROLL
+    for (int m = 0; m < kMaxTableNodes; ++m)
+      if (m < s.n_nodes) sum += s.node_to_power[q * kMaxTableNodes + m] * node[m];
+    p.b[q] = sum;
+  }
+  p.n = s.n_nodes;
+  return p;
 }
 
 // Calls f(i) for i = 0 .. n - 1. kBound > 0 is a compile-time bound on n: the
@@ -146,32 +205,45 @@ NEBULA_HD void store_accumulators(const SpectralSceneView& s, Acc& acc, float* o
   });
 }
 
-// Adds w times the pair's light in every accumulator (the method a template
-// argument, so each kernel holds only its own code).
+// Adds the pair's light in every accumulator (the method a template argument,
+// so each kernel holds only its own code).
 template <SpectralMethod kMethod, class Acc>
-NEBULA_HD void add_pair(const SpectralSceneView& s, int star, float w, float D, Acc& acc) {
+NEBULA_HD void add_pair(const SpectralSceneView& s, int star, const PairWeights& w, float D, Acc& acc) {
   switch (kMethod) {
     case SpectralMethod::Double: {
       const float* q = s.q + size_t(star) * s.n_acc * s.n_lambda;
-      for (int i = 0; i < s.n_lambda; ++i) {
-        const float e = w * expf(-s.kappa[i] * D);
-        for_each_index<Acc::kCols>(s.n_acc, [&](int f) { acc(0, f) += q[f * s.n_lambda + i] * e; });
+      if (s.n_nodes == 0) {  // two loops, not a test per wavelength: the reference's time stays its own
+        for (int i = 0; i < s.n_lambda; ++i) {
+          const float e = w.b[0] * expf(-s.kappa[i] * D);
+          for_each_index<Acc::kCols>(s.n_acc, [&](int f) { acc(0, f) += q[f * s.n_lambda + i] * e; });
+        }
+      } else {
+        for (int i = 0; i < s.n_lambda; ++i) {
+          // P at this wavelength's own scattering depth (q holds S kappa s dlambda).
+          const float e = w.scale * s.table.lookup_at(w.tau_sct * s.kappa[i], w.u) / s.kappa[i] * expf(-s.kappa[i] * D);
+          for_each_index<Acc::kCols>(s.n_acc, [&](int f) { acc(0, f) += q[f * s.n_lambda + i] * e; });
+        }
       }
       break;
     }
     case SpectralMethod::Analytic: {
+      // integral P_poly(lambda) kappa^(p+1) e^(-kappa D), kappa = C_T / lambda: C_T^(p+1) sum_k c_k I_(k-1-p).
       const double a = s.C_T * double(D);
       for_each_index<Acc::kCols>(s.n_acc, [&](int f) {
         const size_t pf = size_t(star) * s.n_acc + f;
         const double* b = s.breaks + pf * (s.segments + 1);
         const double* c = s.coefficients + pf * s.segments * (s.degree + 1);
-        double sum = 0.0;
-        for (int seg = 0; seg < s.segments; ++seg)
-          for (int k = 0; k <= s.degree; ++k) {
-            const double ck = c[seg * (s.degree + 1) + k];
-            if (ck != 0.0) sum += ck * power_exp_integral(k - 1, a, b[seg], b[seg + 1]);
-          }
-        acc(0, f) += w * float(s.C_T * sum);
+        double total = 0.0, C_T_power = s.C_T;
+        for (int p = 0; p < w.n; ++p, C_T_power *= s.C_T) {
+          double sum = 0.0;
+          for (int seg = 0; seg < s.segments; ++seg)
+            for (int k = 0; k <= s.degree; ++k) {
+              const double ck = c[seg * (s.degree + 1) + k];
+              if (ck != 0.0) sum += ck * power_exp_integral(k - 1 - p, a, b[seg], b[seg + 1]);
+            }
+          total += double(w.b[p]) * C_T_power * sum;
+        }
+        acc(0, f) += float(total);
       });
       break;
     }
@@ -184,22 +256,30 @@ NEBULA_HD void add_pair(const SpectralSceneView& s, int star, float w, float D, 
       const int d0 = int(x);
       const float fd = x - float(d0);
       const int N = s.n_basis;
-      if constexpr (kMethod == SpectralMethod::Projection) {
-        const float* c0 = s.coeff + size_t(d0) * N;
-        for_each_index<Acc::kCols>(N, [&](int j) { acc(star, j) += w * (c0[j] + fd * (c0[N + j] - c0[j])); });
-      } else {
-        const float u = s.stars[star].temperature_u;
-        const int t_last = s.n_temperature > 1 ? s.n_temperature - 2 : 0;
-        const int t0 = int(u) < t_last ? int(u) : t_last;
-        const float ft = s.n_temperature > 1 ? u - float(t0) : 0.0f;
-        const float* c00 = s.coeff + (size_t(t0) * s.n_depth + d0) * N;
-        const float* c10 = s.n_temperature > 1 ? c00 + size_t(s.n_depth) * N : c00;
-        for_each_index<Acc::kCols>(N, [&](int j) {
-          const float lo = c00[j] + fd * (c00[N + j] - c00[j]);
-          const float hi = c10[j] + fd * (c10[N + j] - c10[j]);
-          acc(0, j) += w * (lo + ft * (hi - lo));
-        });
-      }
+      // One block of coefficient tables per power of kappa; without a table the
+      // first alone (its own branch, so that the thin limit's code is what it was).
+      const auto add_block = [&](int p, float wp) {
+        if constexpr (kMethod == SpectralMethod::Projection) {
+          const float* c0 = s.coeff + (size_t(p) * s.n_depth + d0) * N;
+          for_each_index<Acc::kCols>(N, [&](int j) { acc(star, j) += wp * (c0[j] + fd * (c0[N + j] - c0[j])); });
+        } else {
+          const float u = s.stars[star].temperature_u;
+          const int t_last = s.n_temperature > 1 ? s.n_temperature - 2 : 0;
+          const int t0 = int(u) < t_last ? int(u) : t_last;
+          const float ft = s.n_temperature > 1 ? u - float(t0) : 0.0f;
+          const float* c00 = s.coeff + ((size_t(p) * s.n_temperature + t0) * s.n_depth + d0) * N;
+          const float* c10 = s.n_temperature > 1 ? c00 + size_t(s.n_depth) * N : c00;
+          for_each_index<Acc::kCols>(N, [&](int j) {
+            const float lo = c00[j] + fd * (c00[N + j] - c00[j]);
+            const float hi = c10[j] + fd * (c10[N + j] - c10[j]);
+            acc(0, j) += wp * (lo + ft * (hi - lo));
+          });
+        }
+      };
+      if (s.n_nodes == 0)
+        add_block(0, w.b[0]);
+      else  // unrolled, so that b[p] is a register on the GPU
+        for_each_index<kMaxTableNodes>(w.n, [&](int p) { add_block(p, w.b[p]); });
       break;
     }
   }
@@ -218,14 +298,17 @@ NEBULA_HD bool depth_coefficients(const SpectralSceneView& s, const float* table
   return true;
 }
 
-// VoxelLight: star k's row of Q_fj at its depth to `cell`, interpolated as
-// row[i] + fd (row[F N + i] - row[i]); null beyond the table.
-NEBULA_HD const float* star_integrals(const SpectralSceneView& s, int k, size_t cell, float& fd) {
+// VoxelLight: star k's row of Q_fj (kappa's power p block) at its depth to
+// `cell`, interpolated as row[i] + fd (row[F N + i] - row[i]); null beyond the table.
+NEBULA_HD size_t star_row(const SpectralSceneView& s, int k, int p, int d0) {
+  return ((size_t(k) * s.n_powers + p) * s.n_depth + d0) * (s.n_acc * s.n_basis);
+}
+NEBULA_HD const float* star_integrals(const SpectralSceneView& s, int k, int p, size_t cell, float& fd) {
   const float x = s.stars[k].depth_v[cell] / s.depth_step;
   if (!(x < float(s.n_depth - 1))) return nullptr;
   const int d0 = int(x);
   fd = x - float(d0);
-  return s.star_coeff + (size_t(k) * s.n_depth + d0) * (s.n_acc * s.n_basis);
+  return s.star_coeff + star_row(s, k, p, d0);
 }
 
 // u[c * stride + i] += (w, grad)[c] times the star's row q interpolated at fd,
@@ -256,7 +339,7 @@ NEBULA_HD void add_star_light(float* __restrict__ u, int stride, const float* __
 // takes the pair exactly. Branch-free: arithmetic and 0/1 masks, so that the
 // CPU's rows of voxels vectorise.
 struct VoxelStarPair {
-  float w, gx, gy, gz, x, near;
+  float w, gx, gy, gz, x, near, mu;
 };
 // What every pair of one pre-pass shares, and star k's part (taken out of the
 // loop over the voxels by hand: the CPU's loop vectorises only so).
@@ -306,7 +389,44 @@ NEBULA_HD VoxelStarPair voxel_star_pair(const SpectralSceneView& s, const Camera
   out.w = wi;
   out.x = x * take;
   out.near = close;
+  out.mu = mu;
   return out;
+}
+
+// Adds one pre-pass pair (weight w > 0, its gradient, star k at table
+// position x) to the sums u. With a table, one row of Q per power of kappa,
+// each weighted by its part b_p of the pair's weight: their sum V = sum_p b_p
+// Q_p is formed first, then added as add_star_light adds w Q (the gradient
+// scaled by V / w: the table's own change with the angle across the voxel is
+// left out, slow beside p_HG's, whose change the gradient carries).
+template <int kFN = 0>
+NEBULA_HD void add_pair_light(const SpectralSceneView& s, float* __restrict__ u, int stride, int k, float tau_v,
+                              float w, float gx, float gy, float gz, float x, float mu) {
+  const int FN = s.n_acc * s.n_basis;
+  const int d0 = int(x);
+  const float fd = x - float(d0);
+  if (s.n_nodes == 0) {
+    add_star_light<kFN>(u, stride, s.star_coeff + star_row(s, k, 0, d0), FN, fd, w, Vec3{gx, gy, gz});
+    return;
+  }
+  const PairWeights pw = pair_weights(s, w, tau_v, mu);
+  const float inv_w = 1.0f / w;
+  const float rx = gx * inv_w, ry = gy * inv_w, rz = gz * inv_w;
+  const float* q0 = s.star_coeff + star_row(s, k, 0, d0);
+  const size_t block = size_t(s.n_depth) * FN;  // from one power's rows to the next's
+  NEBULA_UNROLL
+  for (int i = 0; i < (kFN > 0 ? kFN : FN); ++i) {
+    if (kFN > 0 && i >= FN) break;
+    float v = 0.0f;
+    for_each_index<kMaxTableNodes>(pw.n, [&](int p) {
+      const float* q = q0 + size_t(p) * block;
+      v += pw.b[p] * (q[i] + fd * (q[FN + i] - q[i]));
+    });
+    u[i] += v;
+    u[stride + i] += rx * v;
+    u[2 * stride + i] += ry * v;
+    u[3 * stride + i] += rz * v;
+  }
 }
 
 // VoxelLight's per-view pre-pass for voxels x0 .. x0 + kRow - 1 (those below
@@ -345,9 +465,7 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
                                               inv_rho, tau, s.stars[k].depth_v[cell0]);
       mask |= unsigned(p.near != 0.0f) << k;
       if (p.w == 0.0f) continue;
-      const int d0 = int(p.x);
-      add_star_light<kFN>(u, kFN, s.star_coeff + (size_t(k) * s.n_depth + d0) * FN, FN, p.x - float(d0), p.w,
-                          Vec3{p.gx, p.gy, p.gz});
+      add_pair_light<kFN>(s, u, kFN, k, tau, p.w, p.gx, p.gy, p.gz, p.x, p.mu);
     }
     float* out = light + cell0 * 4 * FN;
     for_each_index<kFN>(FN, [&](int i) {
@@ -372,7 +490,8 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
     }
     // Per star and voxel: weight, its gradient, the table position; the near mask.
     float w[kMaxVoxelLightStars][kRow], gx[kMaxVoxelLightStars][kRow], gy[kMaxVoxelLightStars][kRow],
-        gz[kMaxVoxelLightStars][kRow], xd[kMaxVoxelLightStars][kRow], is_near[kMaxVoxelLightStars][kRow];
+        gz[kMaxVoxelLightStars][kRow], xd[kMaxVoxelLightStars][kRow], is_near[kMaxVoxelLightStars][kRow],
+        mu[kMaxVoxelLightStars][kRow];
     for (int k = 0; k < s.n_stars; ++k) {
       const float* depth = s.stars[k].depth_v + cell0;
       const Vec3 star = s.stars[k].position;
@@ -388,6 +507,7 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
         gz[k][i] = p.gz;
         xd[k][i] = p.x;
         is_near[k][i] = p.near;
+        mu[k][i] = p.mu;
       }
     }
     for (int i = 0; i < n; ++i) {
@@ -395,9 +515,7 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
       for (int j = 0; j < 4 * FN; ++j) u[j] = 0.0f;
       for (int k = 0; k < s.n_stars; ++k) {
         if (w[k][i] == 0.0f) continue;
-        const int d0 = int(xd[k][i]);
-        add_star_light(u, FN, s.star_coeff + (size_t(k) * s.n_depth + d0) * FN, FN, xd[k][i] - float(d0), w[k][i],
-                       Vec3{gx[k][i], gy[k][i], gz[k][i]});
+        add_pair_light(s, u, FN, k, tau[i], w[k][i], gx[k][i], gy[k][i], gz[k][i], xd[k][i], mu[k][i]);
       }
       unsigned mask = 0;
       for (int k = 0; k < s.n_stars; ++k) mask |= unsigned(is_near[k][i] != 0.0f) << k;
@@ -442,20 +560,23 @@ NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir,
           int k = 0;
           while (!((near >> k) & 1u)) ++k;
           float fd = 0.0f;
-          const float* q = star_integrals(s, k, cell, fd);
-          if (!q) continue;
+          if (!star_integrals(s, k, 0, cell, fd)) continue;
           const ChordIrradiance at = chord_irradiance(origin, dir, t, t + chord, s.stars[k].position, s.footprint);
           const Vec3 d = at.point - s.stars[k].position;
           const float r = length(d);
           const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
-          const float w = s.stars[k].power * kInv4Pi * at.inv_r2 * s.albedo * tau_v * hg_phase(mu, s.g) * fraction;
-          for_each_index<Acc::kCols>(F, [&](int f) {
-            float sum = 0.0f;
-            for_each_index<Acc::kBasis>(N, [&](int j) {
-              const int i = f * N + j;
-              sum += c[j] * (q[i] + fd * (q[FN + i] - q[i]));
+          const PairWeights w = pair_weights(
+              s, s.stars[k].power * kInv4Pi * at.inv_r2 * s.albedo * tau_v * hg_phase(mu, s.g) * fraction, tau_v, mu);
+          for_each_index<kMaxTableNodes>(w.n, [&](int p) {
+            const float* q = star_integrals(s, k, p, cell, fd);
+            for_each_index<Acc::kCols>(F, [&](int f) {
+              float sum = 0.0f;
+              for_each_index<Acc::kBasis>(N, [&](int j) {
+                const int i = f * N + j;
+                sum += c[j] * (q[i] + fd * (q[FN + i] - q[i]));
+              });
+              acc(0, f) += w.b[p] * sum;
             });
-            acc(0, f) += w * sum;
           });
         }
       }
@@ -467,7 +588,7 @@ NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir,
         const float r = length(d);
         const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
         const float w = s.stars[k].power * kInv4Pi * at.inv_r2 * s.albedo * tau_v * hg_phase(mu, s.g) * fraction;
-        add_pair<kMethod>(s, k, w, s.stars[k].depth_v[cell] + eye_depth, acc);
+        add_pair<kMethod>(s, k, pair_weights(s, w, tau_v, mu), s.stars[k].depth_v[cell] + eye_depth, acc);
       });
     }
     t += chord;

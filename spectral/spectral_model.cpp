@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Dense>
+
 #include "core/error.h"
 #include "illumination/filters.h"
 
@@ -30,6 +32,30 @@ double mean_over_v(const std::function<double(double)>& f) {
   const double num = passband_integral(v, [&](double nm) { return f(nm / 1000.0); }, kPassbandSubdivisions);
   const double den = passband_integral(v, [](double) { return 1.0; }, kPassbandSubdivisions);
   return num / den;
+}
+
+// The table's nodes (SpectralSettings::table_nodes) over [kappa_min, kappa_max]
+// and the inverse of their Vandermonde matrix: P / kappa at the nodes to the
+// coefficients of its interpolating polynomial in kappa.
+void set_table_nodes(SpectralModel& m, int nodes, double kappa_min, double kappa_max) {
+  m.node_kappa.clear();
+  m.node_to_power.clear();
+  m.n_powers = std::max(nodes, 1);
+  if (nodes == 0) return;
+  if (nodes == 1) {
+    m.node_kappa = {std::clamp(1.0, kappa_min, kappa_max)};
+    m.node_to_power = {1.0};
+    return;
+  }
+  for (int k = 0; k < nodes; ++k) m.node_kappa.push_back(kappa_min + (kappa_max - kappa_min) * k / (nodes - 1));
+  // V[k][p] = kappa_k^p (distinct nodes, at most 4: well posed); row p of V^-1
+  // gives the coefficient of kappa^p.
+  Eigen::MatrixXd V(nodes, nodes);
+  for (int k = 0; k < nodes; ++k)
+    for (int p = 0; p < nodes; ++p) V(k, p) = std::pow(m.node_kappa[k], p);
+  const Eigen::MatrixXd inverse = V.fullPivLu().inverse();
+  for (int p = 0; p < nodes; ++p)
+    for (int k = 0; k < nodes; ++k) m.node_to_power.push_back(inverse(p, k));
 }
 
 }  // namespace
@@ -67,6 +93,9 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
                 std::to_string(stars.size()));
   if (!(settings.near_voxels >= 0 && std::isfinite(settings.near_voxels)))
     throw Error("spectral: near_voxels is " + to_text(settings.near_voxels) + "; must be >= 0");
+  if (settings.table_nodes < 0 || settings.table_nodes > kMaxTableNodes)
+    throw Error("spectral: table_nodes is " + std::to_string(settings.table_nodes) + "; must be in 0.." +
+                std::to_string(kMaxTableNodes) + " (0: the thin-voxel limit)");
   if (settings.method == SpectralMethod::Analytic && settings.attenuation != Attenuation::Inverse)
     throw Error("spectral: the analytic integral needs the attenuation C_T / lambda (attenuation = \"inverse\")");
   SpectralModel m;
@@ -98,12 +127,14 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
     m.hi_um = settings.hi_um;
   }
   m.grid = WavelengthGrid::uniform(m.lo_um, m.hi_um, settings.grid_nodes);
-  double kappa_min = 1e30;
+  double kappa_min = 1e30, kappa_max = 0;
   for (double l : m.grid.lambda) {
     m.kappa_grid.push_back(m.kappa_at(l));
     kappa_min = std::min(kappa_min, m.kappa_grid.back());
+    kappa_max = std::max(kappa_max, m.kappa_grid.back());
   }
   m.max_eye_depth = float(kTransmittanceCut / kappa_min);
+  set_table_nodes(m, settings.table_nodes, kappa_min, kappa_max);
   m.max_depth = settings.max_depth > 0 ? settings.max_depth : kTransmittanceCut / kappa_min;
   m.fit_depth = settings.fit_depth > 0 ? settings.fit_depth : std::min(kFitDepth, m.max_depth);
   if (!(m.fit_depth <= m.max_depth))
@@ -190,15 +221,18 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
       const int D = settings.depth_nodes;
       m.depth_step = float(m.max_depth / (D - 1));
       std::vector<double> f(m.grid.lambda.size());
-      for (int t = 0; t < m.n_temperature; ++t) {
-        const double T = temperature_at(t, m.n_temperature);
-        for (int d = 0; d < D; ++d) {
-          for (size_t i = 0; i < f.size(); ++i)
-            f[i] = (light ? planck_shape(m.grid.lambda[i], T) : 1.0) * std::exp(-m.kappa_grid[i] * d * m.depth_step);
-          for (double c : settings.relative ? project_relative(m.grid, m.basis, f) : project(m.grid, m.basis, f))
-            m.coeff.push_back(float(c));
+      // A block per power p of kappa (tables, spectral_march.h): kappa^p s_T e^(-kappa D) on the basis.
+      for (int p = 0; p < m.n_powers; ++p)
+        for (int t = 0; t < m.n_temperature; ++t) {
+          const double T = temperature_at(t, m.n_temperature);
+          for (int d = 0; d < D; ++d) {
+            for (size_t i = 0; i < f.size(); ++i)
+              f[i] = (light ? planck_shape(m.grid.lambda[i], T) : 1.0) * std::pow(m.kappa_grid[i], p) *
+                     std::exp(-m.kappa_grid[i] * d * m.depth_step);
+            for (double c : settings.relative ? project_relative(m.grid, m.basis, f) : project(m.grid, m.basis, f))
+              m.coeff.push_back(float(c));
+          }
         }
-      }
       for (const SpectralStar& s : stars) {
         const double u = (std::log(s.temperature_K) - std::log(kMinTemperature)) /
                          (std::log(kMaxTemperature) - std::log(kMinTemperature)) * (m.n_temperature - 1);
@@ -235,18 +269,21 @@ void build_star_tables(SpectralModel& m) {
         for (int j = 0; j < n; ++j) h[(size_t(s) * F + f) * n + j][i] = base * m.basis.phi[j][i];
       }
   m.n_acc = F;
-  m.star_coeff.assign(size_t(S) * D * F * n, 0.0f);
+  const int P = m.n_powers;  // tables: a block per power of kappa, Q^p = integral S_f kappa^(p+1) s e^(-kappa D) phi_j
+  m.star_coeff.assign(size_t(S) * P * D * F * n, 0.0f);
   std::vector<double> e(G);
-  for (int d = 0; d < D; ++d) {
-    for (size_t i = 0; i < G; ++i) e[i] = std::exp(-m.kappa_grid[i] * d * double(m.depth_step));
-    for (int s = 0; s < S; ++s)
-      for (int fj = 0; fj < F * n; ++fj) {
-        const std::vector<double>& row = h[size_t(s) * F * n + fj];
-        double sum = 0.0;
-        for (size_t i = 0; i < G; ++i) sum += row[i] * e[i];
-        m.star_coeff[(size_t(s) * D + d) * F * n + fj] = float(sum);
-      }
-  }
+  for (int p = 0; p < P; ++p)
+    for (int d = 0; d < D; ++d) {
+      for (size_t i = 0; i < G; ++i)
+        e[i] = std::pow(m.kappa_grid[i], p) * std::exp(-m.kappa_grid[i] * d * double(m.depth_step));
+      for (int s = 0; s < S; ++s)
+        for (int fj = 0; fj < F * n; ++fj) {
+          const std::vector<double>& row = h[size_t(s) * F * n + fj];
+          double sum = 0.0;
+          for (size_t i = 0; i < G; ++i) sum += row[i] * e[i];
+          m.star_coeff[((size_t(s) * P + p) * D + d) * F * n + fj] = float(sum);
+        }
+    }
   m.resolve.assign(size_t(F) * F, 0.0f);
   for (int f = 0; f < F; ++f) m.resolve[size_t(f) * F + f] = 1.0f;
 }
@@ -310,7 +347,12 @@ SpectralSceneView view_of(const SpectralModel& m) {
   v.depth_step = m.depth_step;
   v.coeff = m.coeff.data();
   v.star_coeff = m.star_coeff.data();
-  return v;
+  v.n_powers = m.n_powers;
+  for (size_t i = 0; i < m.node_kappa.size(); ++i) v.node_kappa[i] = float(m.node_kappa[i]);
+  const int K = int(m.node_kappa.size());
+  for (int p = 0; p < K; ++p)
+    for (int k = 0; k < K; ++k) v.node_to_power[p * kMaxTableNodes + k] = float(m.node_to_power[size_t(p) * K + k]);
+  return v;  // n_nodes stays 0 (the thin limit) until the renderer is given a table
 }
 
 double reference_integral(const SpectralModel& m, int filter, const SpectralStar& star, double D) {

@@ -55,6 +55,13 @@ struct SpectralSettings {
   // VoxelLight: a voxel whose centre lies within this many voxels of a star takes
   // that star's pair exactly in the march (1/r^2 is not smooth there; docs/spectral.md).
   double near_voxels = 10;
+  // Tables (docs/spectral.md, "Tables"): the attenuations kappa at which a pair
+  // reads the voxel's scattering table P(a tau_V kappa, mu), 1..kMaxTableNodes
+  // (1: at kappa = 1, the V band's depth, for every wavelength; n >= 2: evenly
+  // over the basis' range, P / kappa a polynomial of degree n - 1 in kappa
+  // between them); 0: the thin-voxel limit only. The renderer uses a table only
+  // when given one.
+  int table_nodes = 0;
 };
 
 struct SpectralStar {
@@ -90,13 +97,18 @@ struct SpectralModel {
   int n_temperature = 1;
   float max_eye_depth = 1e30f;
   std::vector<float> resolve;  // [filter][acc]
+  // Tables: the nodes' attenuations and the map from P / kappa at them to the
+  // powers of kappa ([p][m]); n_powers blocks in coeff and star_coeff.
+  std::vector<double> node_kappa, node_to_power;
+  int n_powers = 1;
   double kappa_at(double lambda_um) const;
 };
 
 // Errors (ParameterError-free: callers name their keys): no filter, a filter
 // outside the law's range, basis < 1 or > 16, wavelengths < 2, a temperature
 // not positive, Analytic with the Law attenuation, LightBasis with a
-// tabulated star, VoxelLight with more than 32 stars or near_voxels < 0.
+// tabulated star, VoxelLight with more than 32 stars or near_voxels < 0,
+// table_nodes outside 0..4.
 SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Passband>>& filters,
                                    const std::vector<SpectralStar>& stars, const SpectralSettings& settings);
 

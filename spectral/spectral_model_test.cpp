@@ -25,7 +25,8 @@ double pair_value(const SpectralModel& m, int filter, int star, double D) {
   v.stars = stars.data();
   DynamicAccumulators acc{};
   acc.cols = accumulator_cols(v);
-  dispatch_method(m.settings.method, [&](auto method) { add_pair<method()>(v, star, 1.0f, float(D), acc); });
+  dispatch_method(m.settings.method,
+                  [&](auto method) { add_pair<method()>(v, star, pair_weights(v, 1.0f, 0.0f, 0.0f), float(D), acc); });
   double sum = 0;
   for (int k = 0; k < m.n_acc; ++k) sum += double(m.resolve[size_t(filter) * m.n_acc + k]) * acc.v[k];
   return sum;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <string>
 
 #include "core/error.h"
@@ -19,8 +20,20 @@ void check(const SpectralRenderInputs& in) {
   for (const SpectralLight& l : in.lights)
     if (!l.depth_v || l.depth_v->size() != in.density->shape.count())
       throw Error("spectral render: a star has no baked depth for this grid");
+  if (in.table && in.model->settings.table_nodes > 0 &&
+      (std::fabs(in.table->albedo - in.albedo) > 1e-6 || std::fabs(in.table->g - in.g) > 1e-6))
+    throw Error("spectral render: the table is for albedo " + to_text(in.table->albedo) + ", g " +
+                to_text(in.table->g) + "; the dust has albedo " + to_text(in.albedo) + ", g " + to_text(in.g));
 }
 }  // namespace
+
+void set_table(SpectralSceneView& view, const SpectralRenderInputs& in, const float* P) {
+  if (!in.table || in.model->settings.table_nodes == 0) return;  // the thin limit
+  view.table = nebula::view_of(*in.table);
+  view.table.P = P;
+  view.table.C = nullptr;  // only lookup_at is used
+  view.n_nodes = in.model->settings.table_nodes;
+}
 
 Image render_spectral(const SpectralRenderInputs& in, Backend backend, double* seconds) {
   check(in);
@@ -41,6 +54,7 @@ Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds) {
   view.albedo = in.albedo;
   view.g = in.g;
   view.footprint = in.camera.footprint();
+  set_table(view, in, in.table ? in.table->P.data() : nullptr);
   std::vector<std::string> names;
   for (int k = 0; k < m.n_acc; ++k) names.push_back("acc" + std::to_string(k));
   Image image(in.camera.width, in.camera.height, names);

@@ -10,6 +10,7 @@
 #include "core/grid.h"
 #include "core/image.h"
 #include "spectral/spectral_model.h"
+#include "tables/scattering_table.h"
 
 namespace nebula::spectral {
 
@@ -32,17 +33,26 @@ struct SpectralRenderInputs {
   const SpectralModel* model = nullptr;  // built for these lights, in this order
   std::vector<SpectralLight> lights;
   float albedo = 0.6f, g = 0.6f;
+  // The voxels' scattering table for (albedo, g), read at the model's
+  // table_nodes attenuations (docs/spectral.md, "Tables"); null, or a model
+  // with table_nodes 0: the thin-voxel limit P = tau_sct p_HG.
+  const ScatteringTable* table = nullptr;
   Camera camera;
   VoxelLightWorkspace* workspace = nullptr;  // VoxelLight on the CPU: reused buffers (optional)
 };
 
 // The accumulator image (model->n_acc planes); `seconds` the march alone
-// (CUDA events on the GPU). Throws Error on inconsistent inputs.
+// (CUDA events on the GPU). Throws Error on inconsistent inputs (a table for
+// another albedo or g than the dust's among them).
 Image render_spectral(const SpectralRenderInputs& in, Backend backend, double* seconds = nullptr);
 Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds);
 Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds);
 
 // One plane per filter (the model's names), times the exposure.
 Image resolve_filters(const Image& accumulators, const SpectralModel& model, float exposure = 1.0f);
+
+// The scene view's table fields for these inputs (both backends; `P` is the
+// table's values where they live, host or device).
+void set_table(SpectralSceneView& view, const SpectralRenderInputs& in, const float* P);
 
 }  // namespace nebula::spectral

@@ -111,6 +111,7 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
   view.albedo = in.albedo;
   view.g = in.g;
   view.footprint = in.camera.footprint();
+  if (in.table) set_table(view, in, upload(floats, in.table->P));
   view.kappa = upload(floats, m.kappa);
   view.q = upload(floats, m.q);
   view.coeff = upload(floats, m.coeff);

@@ -6,12 +6,14 @@
 #include "core/gpu.h"
 #include "illumination/filters.h"
 #include "spectral/spectral_test_scene.h"
+#include "tables/test_tables.h"
 
 namespace nebula::spectral {
 namespace {
 
 // The same march_spectral on both backends, every method (the voxel-light
-// method's pre-pass too, voxel_light on both): accumulators agree to 1e-4 of
+// method's pre-pass too, voxel_light on both), without and with a table:
+// accumulators agree to 1e-4 of
 // their peak (float contraction moves voxel crossings by ulps).
 TEST(SpectralRendererGpu, AgreesWithTheCpu) {
   std::string why;
@@ -19,22 +21,28 @@ TEST(SpectralRendererGpu, AgreesWithTheCpu) {
   auto scene = testing::noise_scene(24, 0.6f, {{0.1f, 0.2f, -0.1f}, {-0.3f, 0.0f, 0.2f}}, 64, 48);
   std::vector<std::pair<std::string, Passband>> f;
   for (const char* n : {"B", "V", "R"}) f.push_back({n, load_filter(n)});
+  const ScatteringTable table = nebula::testing::make_test_table(5.0, 501, AngularBinning::UniformTheta, 90, 0.6);
   for (SpectralMethod method : {SpectralMethod::Double, SpectralMethod::Analytic, SpectralMethod::Projection,
-                                SpectralMethod::LightBasis, SpectralMethod::VoxelLight}) {
-    SpectralSettings s;
-    s.method = method;
-    const SpectralModel m = build_spectral_model(f, {{41400}, {5770}}, s);
-    const Image cpu = render_spectral(scene.inputs(m), Backend::Cpu);
-    const Image gpu = render_spectral(scene.inputs(m), Backend::Cuda);
-    double peak = 0, worst = 0;
-    for (size_t i = 0; i < cpu.pixels.size(); ++i) {
-      peak = std::max(peak, double(std::fabs(cpu.pixels[i])));
-      worst = std::max(worst, double(std::fabs(cpu.pixels[i] - gpu.pixels[i])));
+                                SpectralMethod::LightBasis, SpectralMethod::VoxelLight})
+    for (int nodes : {0, 3}) {  // the thin limit; the table at 3 attenuations (docs/spectral.md, "Tables")
+      SpectralSettings s;
+      s.method = method;
+      s.table_nodes = nodes;
+      const SpectralModel m = build_spectral_model(f, {{41400}, {5770}}, s);
+      SpectralRenderInputs in = scene.inputs(m);
+      in.table = nodes > 0 ? &table : nullptr;
+      const Image cpu = render_spectral(in, Backend::Cpu);
+      const Image gpu = render_spectral(in, Backend::Cuda);
+      double peak = 0, worst = 0;
+      for (size_t i = 0; i < cpu.pixels.size(); ++i) {
+        peak = std::max(peak, double(std::fabs(cpu.pixels[i])));
+        worst = std::max(worst, double(std::fabs(cpu.pixels[i] - gpu.pixels[i])));
+      }
+      std::printf("  method %d, %d table nodes: largest CPU-GPU difference %.3g of the peak\n", int(method), nodes,
+                  worst / peak);
+      EXPECT_GT(peak, 0.0);
+      EXPECT_LT(worst, 1e-4 * peak);
     }
-    std::printf("  method %d: largest CPU-GPU difference %.3g of the peak\n", int(method), worst / peak);
-    EXPECT_GT(peak, 0.0);
-    EXPECT_LT(worst, 1e-4 * peak);
-  }
 }
 
 }  // namespace
