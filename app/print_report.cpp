@@ -94,7 +94,18 @@ void print_spectral(const RunReport& r) {
   if (r.bake.done)
     std::printf("  bake: %zu star(s) x %llu voxels, %g s\n", r.bake.stars, (unsigned long long)r.bake.cells,
                 r.bake.seconds);
-  std::printf("  single scattering per voxel (thin-voxel HG); no tables, no light between voxels, no emission\n");
+  for (const TableReport& t : r.tables) {
+    if (!t.warning.empty()) std::fprintf(stderr, "nebula: warning: %s\n", t.warning.c_str());
+    std::printf("  table a=%g g=%g: %s %s (%.3g s)\n", t.albedo, t.g, to_string(t.origin), t.path.c_str(), t.seconds);
+  }
+  if (s.table_nodes > 0) {
+    std::printf("  scattering per voxel through its table (multiple scattering inside it), read at kappa =");
+    for (double k : s.node_kappa) std::printf(" %.3g", k);
+    std::printf(" and interpolated in kappa between; no light between voxels, no emission\n");
+  } else {
+    std::printf("  single scattering per voxel (thin-voxel HG, spectral.tables = false); no light between voxels, "
+                "no emission\n");
+  }
 }
 
 void print_computed(const RunReport& r) {

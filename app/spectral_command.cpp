@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <thread>
 
 #include "app/commands.h"
@@ -22,6 +23,7 @@
 #include "scene/scene_file.h"
 #include "spectral/piecewise_polynomial.h"
 #include "spectral/spectral_renderer.h"
+#include "tables/table_file.h"
 #include "illumination/filter_file.h"
 
 namespace nebula::app {
@@ -111,7 +113,7 @@ std::string json_string(const std::string& s) {
 
 struct BenchRow {
   std::string method, norm;
-  int basis = 0, wavelengths = 0;
+  int basis = 0, wavelengths = 0, table_nodes = 0;
   double ms = 0, speedup = 0, max_err = 0, mean_err = 0, p99_err = 0;
 };
 
@@ -121,7 +123,8 @@ void add_spectral_bench(CLI::App* bench) {
   auto* cmd = bench->add_subcommand(
       "spectral", "spectral methods against the double numerical integral (error, time; docs/spectral.md)");
   struct Options {
-    std::string backends = "auto", scene, json, attenuation = "inverse";
+    std::string backends = "auto", scene, json, attenuation = "inverse", table;
+    int table_nodes = 3;
     std::vector<std::string> overrides;
     int size = 64, width = 256, height = 256, repeats = 3, stars = 1, reference = 400;
     double near_voxels = spectral::SpectralSettings{}.near_voxels;
@@ -152,6 +155,12 @@ void add_spectral_bench(CLI::App* bench) {
       ->check(CLI::Range(0.0, 1000.0));
   cmd->add_flag("--quick", o->quick,
                 "fewer rows (double M = 20, projection N = 4, light basis N = 4 and 6, voxel light N = 4)");
+  cmd->add_option("--table", o->table,
+                  "the voxels' scattering table (an HDF5 file from `nebula tabulate`, for the dust's albedo and g): "
+                  "every method reads it (docs/spectral.md, \"Tables\"); default: the thin-voxel limit");
+  cmd->add_option("--table-nodes", o->table_nodes, "with --table: attenuations the table is read at")
+      ->capture_default_str()
+      ->check(CLI::Range(1, spectral::kMaxTableNodes));
   cmd->add_option("--json", o->json, "also write the results as JSON to this file");
   cmd->callback([o, width, height] {
     if (o->attenuation != "inverse" && o->attenuation != "law")
@@ -206,6 +215,13 @@ void add_spectral_bench(CLI::App* bench) {
       b.camera = make_camera(cs);
       for (const std::string& f : o->filters) b.filters.push_back({f, load_filter(f)});
     }
+    std::optional<ScatteringTable> table;
+    if (!o->table.empty()) {
+      table = read_table(o->table);
+      if (std::fabs(table->albedo - b.albedo) > 1e-6 || std::fabs(table->g - b.g) > 1e-6)
+        throw Error("--table: " + o->table + " holds albedo " + to_text(table->albedo) + ", g " + to_text(table->g) +
+                    "; the dust has albedo " + to_text(b.albedo) + ", g " + to_text(b.g));
+    }
     const BakeResult bake = bake_star_depths(b.grid, b.positions, gpu ? Backend::Cuda : Backend::Cpu);
     std::vector<spectral::SpectralStar> stars;
     for (double t : b.temperature) stars.push_back({t});
@@ -220,17 +236,22 @@ void add_spectral_bench(CLI::App* bench) {
       in.albedo = b.albedo;
       in.g = b.g;
       in.camera = b.camera;
+      in.table = table ? &*table : nullptr;
       return in;
     };
     std::string filter_list;
     for (const auto& f : b.filters) filter_list += (filter_list.empty() ? "" : " ") + f.first;
-    std::printf("%s: grid %dx%dx%d, %dx%d pixels, %d star(s), filters %s, attenuation %s\n", b.name.c_str(),
+    std::printf("%s: grid %dx%dx%d, %dx%d pixels, %d star(s), filters %s, attenuation %s, %s\n", b.name.c_str(),
                 b.grid.shape.nx, b.grid.shape.ny, b.grid.shape.nz, b.camera.width, b.camera.height, S,
-                filter_list.c_str(), o->attenuation.c_str());
+                filter_list.c_str(), o->attenuation.c_str(),
+                table ? ("table " + o->table + " read at " + std::to_string(o->table_nodes) + " attenuations").c_str()
+                      : "thin-voxel limit (no table)");
     std::string json = "{\n  \"scene\": " + json_string(b.name) + ",\n  \"stars\": " + std::to_string(S) +
                        ",\n  \"width\": " + std::to_string(b.camera.width) + ",\n  \"height\": " +
                        std::to_string(b.camera.height) + ",\n  \"filters\": " + json_string(filter_list) +
-                       ",\n  \"attenuation\": " + json_string(o->attenuation) + ",\n  \"runs\": [";
+                       ",\n  \"attenuation\": " + json_string(o->attenuation) + ",\n  \"table\": " +
+                       json_string(o->table) + ",\n  \"table_nodes\": " + std::to_string(table ? o->table_nodes : 0) +
+                       ",\n  \"runs\": [";
     for (size_t bi = 0; bi < backends.size(); ++bi) {
       const Backend backend = backends[bi];
       // Median time of the march and the resolve (the march alone by CUDA events on the GPU;
@@ -256,6 +277,7 @@ void add_spectral_bench(CLI::App* bench) {
       base.R_V = b.R_V;
       base.law = b.law;
       base.near_voxels = o->near_voxels;
+      base.table_nodes = table ? o->table_nodes : 0;  // the reference reads the table at each wavelength
       spectral::SpectralSettings ref_settings = base;
       ref_settings.method = spectral::SpectralMethod::Double;
       ref_settings.wavelengths = o->reference;
@@ -299,6 +321,7 @@ void add_spectral_bench(CLI::App* bench) {
                                                                       : "voxel_light";
         r.norm = s.relative ? "relative" : "absolute";
         r.basis = m.basis.size();
+        r.table_nodes = table ? s.table_nodes : 0;
         r.wavelengths = s.method == spectral::SpectralMethod::Double ? s.wavelengths : 0;
         r.speedup = ref_time * 1e3 / r.ms;
         errors(img, r);
@@ -321,6 +344,14 @@ void add_spectral_bench(CLI::App* bench) {
         s.basis = n;
         row("projection, N = " + std::to_string(n), s);
       }
+      if (table)  // the table's attenuations: their error against the reference's lookup at every wavelength
+        for (int nodes = 1; nodes <= spectral::kMaxTableNodes; ++nodes)
+          if (nodes != o->table_nodes) {
+            s.basis = 4;
+            s.table_nodes = nodes;
+            row("projection, N = 4, " + std::to_string(nodes) + " node(s)", s);
+          }
+      s.table_nodes = base.table_nodes;
       s.relative = false;
       for (int n : o->quick ? std::vector<int>{} : std::vector<int>{3, 4}) {
         s.basis = n;
@@ -383,7 +414,8 @@ void add_spectral_bench(CLI::App* bench) {
         const BenchRow& r = rows[i];
         json += std::string(i ? "," : "") + "\n      {\"method\": " + json_string(r.method) + ", \"norm\": " +
                 json_string(r.norm) + ", \"basis\": " + std::to_string(r.basis) + ", \"wavelengths\": " +
-                std::to_string(r.wavelengths) + ", \"ms\": " + to_text(r.ms) + ", \"speedup\": " + to_text(r.speedup) +
+                std::to_string(r.wavelengths) + ", \"table_nodes\": " + std::to_string(r.table_nodes) +
+                ", \"ms\": " + to_text(r.ms) + ", \"speedup\": " + to_text(r.speedup) +
                 ", \"max_err\": " + to_text(r.max_err) + ", \"p99_err\": " + to_text(r.p99_err) +
                 ", \"mean_err\": " + to_text(r.mean_err) + "}";
       }

@@ -106,6 +106,8 @@ struct SpectralReport {
   double basis_error = 0;         // the greedy's largest residual over its family with all elements
   int accumulators = 0;           // numbers each ray carries
   std::vector<SpectralFilterReport> filters;
+  int table_nodes = 0;            // attenuations the voxels' table is read at; 0: the thin limit (no table)
+  std::vector<double> node_kappa; // their kappa = tau / tau_V
   double model_seconds = 0;       // fits, basis and tables (host)
   double resolve_seconds = 0;     // accumulators to one plane per filter
 };

@@ -10,6 +10,7 @@
 #include "pipeline/render_scene.h"
 #include "pipeline/run_setup.h"
 #include "pipeline/spectral_scene.h"
+#include "pipeline/table_source.h"
 #include "spectral/spectral_renderer.h"
 
 namespace nebula {
@@ -44,6 +45,7 @@ spectral::SpectralSettings spectral_settings(const Scene& scene) {
   s.near_voxels = p.near_voxels;
   s.lo_um = p.range_lo_um;
   s.hi_um = p.range_hi_um;
+  s.table_nodes = p.tables ? p.table_nodes : 0;
   return s;
 }
 
@@ -55,6 +57,19 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
   RunReport report = begin_report(scene, bands, "spectral", o.backend);
   report.mode = "spectral " + scene.spectral->method;
   report.multiple_scattering = "none";
+
+  // The voxels' scattering table for the dust's (albedo, g): the scene's file or
+  // the cached one (generated on first use), as the band renderer takes it.
+  std::shared_ptr<const ScatteringTable> table;
+  if (scene.spectral->tables) {
+    BandTables tables = resolve_tables(scene, {o.backend, o.table_photons, o.progress});
+    for (const auto& t : tables.per_band)
+      if (t) {
+        table = t;
+        break;
+      }
+    report.tables = tables.report;
+  }
 
   // The model: filters as piecewise cubics, basis and tables (host).
   const auto t_model = std::chrono::steady_clock::now();
@@ -82,6 +97,8 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
   sr.elements = model.element_depth;
   sr.basis_error = model.basis.error.empty() ? 0.0 : model.basis.error.back();
   sr.accumulators = model.n_acc;
+  sr.table_nodes = table ? settings.table_nodes : 0;
+  sr.node_kappa = table ? model.node_kappa : std::vector<double>{};
   for (size_t b = 0; b < filters.size(); ++b)
     sr.filters.push_back({filters[b].first, filters[b].second.wavelength_nm.front(),
                           filters[b].second.wavelength_nm.back(), pivot_wavelength_nm(filters[b].second),
@@ -105,6 +122,7 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
     in.lights.push_back({scene.stars[k].position, scene.stars[k].luminosity_lsun, &bake.tau_v[k]});
   in.albedo = float(scene.dust.albedo.front());
   in.g = float(scene.dust.g.front());
+  in.table = table.get();
   in.camera = make_camera(scene.camera);
   double march_seconds = 0;
   const Image acc = spectral::render_spectral(in, o.backend, &march_seconds);
@@ -118,7 +136,10 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
 
   out.report = report;
   out.metadata = scene_metadata(scene, bands, scene.camera, report.mode);
-  out.metadata.entries.push_back({"multiple_scattering", "none (spectral renderer: single scattering)"});
+  out.metadata.entries.push_back(
+      {"multiple_scattering", table ? "inside voxels (tables), none between them (spectral renderer)"
+                                    : "none (spectral renderer: thin-voxel single scattering)"});
+  out.metadata.entries.push_back({"spec_nodes", sr.table_nodes});
   out.metadata.entries.push_back({"spec_method", sr.method});
   out.metadata.entries.push_back({"spec_basis", sr.basis});
   out.metadata.entries.push_back({"spec_atten", sr.attenuation});

@@ -170,6 +170,9 @@ std::optional<SceneIssue> spectral_issue(const Scene& s) {
       return SceneIssue{key, "is " + to_text(v) + "; must be in [0, 1000] (V-band optical depth; 0: automatic)"};
   if (!(std::isfinite(p.near_voxels) && p.near_voxels >= 0 && p.near_voxels <= 1000))
     return SceneIssue{"spectral.near_voxels", "is " + to_text(p.near_voxels) + "; must be in [0, 1000] (voxels)"};
+  if (p.table_nodes < 1 || p.table_nodes > 4)
+    return SceneIssue{"spectral.table_nodes",
+                      "is " + std::to_string(p.table_nodes) + "; must be in 1..4 (attenuations the table is read at)"};
   if (p.fit_depth > 0 && p.max_depth > 0 && p.fit_depth > p.max_depth)
     return SceneIssue{"spectral.fit_depth", "is " + to_text(p.fit_depth) + ", beyond spectral.max_depth " +
                                                 to_text(p.max_depth)};
@@ -187,8 +190,13 @@ std::optional<SceneIssue> spectral_issue(const Scene& s) {
     return SceneIssue{"dust.albedo", "the spectral renderer takes one albedo for every wavelength; give one number"};
   if (!all_equal(s.dust.g))
     return SceneIssue{"dust.g", "the spectral renderer takes one g for every wavelength; give one number"};
-  for (const std::string& f : s.dust.table_files)
-    if (!f.empty()) return SceneIssue{"dust.tables", "the spectral renderer uses no scattering tables"};
+  for (const std::string& f : s.dust.table_files) {
+    if (!f.empty() && !p.tables)
+      return SceneIssue{"dust.tables", "spectral.tables = false (the thin-voxel limit) reads no scattering table"};
+    if (f != s.dust.table_files.front())
+      return SceneIssue{"dust.tables", "the spectral renderer reads one table at every wavelength; name the same "
+                                       "file for every band"};
+  }
   if (p.method == "projection" && s.stars.size() * size_t(p.basis) > 64)
     return SceneIssue{"spectral.basis", std::to_string(s.stars.size()) + " stars x " + std::to_string(p.basis) +
                                             " elements exceed the 64 numbers a ray carries; use method = "

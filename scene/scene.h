@@ -127,8 +127,9 @@ struct SceneFilter {
 // The spectral renderer ([spectral] in a scene file; docs/scene.md,
 // docs/spectral.md): every band integrated over wavelength through its filter
 // (Barres 2023) instead of the band renderer's one extinction ratio and star
-// power per band. Single scattering in each voxel (the thin-voxel HG phase
-// function), no tables, no light between voxels.
+// power per band. Each voxel scatters the stars' light through its scattering
+// table (multiple scattering inside the voxel) read at a few attenuations;
+// no light between voxels yet.
 struct SpectralSpec {
   std::string method = "projection";  // double, analytic, projection, light_density, voxel_light
   int basis = 4;                      // elements of the greedy basis, 1..16
@@ -139,6 +140,8 @@ struct SpectralSpec {
   double max_depth = 0;               // the coefficient table's range; 0: automatic
   double near_voxels = 10;            // voxel_light: pairs this close to a star (in voxels) taken exactly
   double range_lo_um = 0, range_hi_um = 0;  // the basis' wavelength range; 0: the bands' span
+  bool tables = true;                 // the voxel's table P(a tau_V kappa, mu); false: the thin limit tau_sct p_HG
+  int table_nodes = 3;                // attenuations kappa at which the table is read, 1..4
 };
 
 // A file a scene reads: the key that names it ("scene" for the scene file

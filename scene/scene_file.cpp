@@ -65,7 +65,8 @@ const std::initializer_list<std::string_view> kTopKeys = {"bands",  "density", "
                                                           "camera", "output",  "render",   "axial",  "filters",
                                                           "spectral", "animation", "display"};
 const std::initializer_list<std::string_view> kSpectralKeys = {
-    "method", "basis", "wavelengths", "attenuation", "norm", "fit_depth", "max_depth", "range_um", "near_voxels"};
+    "method", "basis", "wavelengths", "attenuation", "norm", "fit_depth", "max_depth", "range_um", "near_voxels",
+    "tables", "table_nodes"};
 const std::initializer_list<std::string_view> kRenderKeys = {
     "levels", "multiple_scattering", "diffuse_order", "diffuse_zonal", "diffuse_cells", "diffuse_photons", "diffuse_seed",
     "samples_per_pixel"};
@@ -397,6 +398,8 @@ std::optional<SpectralSpec> Parser::parse_spectral(const toml::table& root) cons
   if (const toml::node* v = t.get("fit_depth")) p.fit_depth = number(*v, "spectral.fit_depth");
   if (const toml::node* v = t.get("max_depth")) p.max_depth = number(*v, "spectral.max_depth");
   if (const toml::node* v = t.get("near_voxels")) p.near_voxels = number(*v, "spectral.near_voxels");
+  if (const toml::node* v = t.get("tables")) p.tables = boolean(*v, "spectral.tables");
+  if (const toml::node* v = t.get("table_nodes")) p.table_nodes = small_integer(*v, "spectral.table_nodes");
   if (const toml::node* v = t.get("range_um")) {
     const toml::array* a = v->as_array();
     if (a == nullptr || a->size() != 2)

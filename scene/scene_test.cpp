@@ -678,6 +678,12 @@ TEST_F(SceneFile, UserFiltersAndTheSpectralTableAreReadAndChecked) {
   EXPECT_EQ(spectral.spectral->basis, 4);
   EXPECT_EQ(spectral.spectral->fit_depth, 6.0);
   EXPECT_EQ(spectral.spectral->attenuation, "law");
+  EXPECT_TRUE(spectral.spectral->tables);
+  EXPECT_EQ(spectral.spectral->table_nodes, 3);
+  const Scene thin =
+      load_scene(write_text("thin.toml", with_filter + "[spectral]\ntables = false\ntable_nodes = 2\n"));
+  EXPECT_FALSE(thin.spectral->tables);
+  EXPECT_EQ(thin.spectral->table_nodes, 2);
 
   write_text("filters/bad.txt", "650 0\n660 1\n655 1\n");
   refused("bad_curve", std::string("bands = [\"Hx\"]\n[filters]\nHx = \"filters/bad.txt\"\n") + kBase,
@@ -699,6 +705,8 @@ TEST_F(SceneFile, UserFiltersAndTheSpectralTableAreReadAndChecked) {
   refused("fit_past_max", s + "fit_depth = 9\nmax_depth = 5\n", {"spectral.fit_depth", "max_depth"});
   refused("range", s + "range_um = [0.9, 0.3]\n", {"spectral.range_um", "0 < lo < hi"});
   refused("near_voxels", s + "near_voxels = -1\n", {"spectral.near_voxels", "[0, 1000]"});
+  refused("table_nodes", s + "table_nodes = 0\n", {"spectral.table_nodes", "1..4"});
+  refused("tables", s + "tables = \"yes\"\n", {"spectral.tables", "true or false"});
   refused("voxel_method", s + "method = \"voxels\"\n", {"spectral.method", "voxel_light"});
   refused("key", s + "elements = 3\n", {"spectral.elements", "unknown key"});
   refused("temperature", edited("class = \"O5V\"", "temperature_K = 0") + "[spectral]\n",
