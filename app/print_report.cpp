@@ -96,7 +96,10 @@ void print_spectral(const RunReport& r) {
                 r.bake.seconds);
   for (const TableReport& t : r.tables) {
     if (!t.warning.empty()) std::fprintf(stderr, "nebula: warning: %s\n", t.warning.c_str());
-    std::printf("  table a=%g g=%g: %s %s (%.3g s)\n", t.albedo, t.g, to_string(t.origin), t.path.c_str(), t.seconds);
+    std::printf("  table a=%g g=%g: %s %s (%.3g s); its entries' median standard error %.2g%% (%llu photons a "
+                "row: --table-photons)\n",
+                t.albedo, t.g, to_string(t.origin), t.path.c_str(), t.seconds, 100 * t.noise,
+                (unsigned long long)t.photons_per_row);
   }
   if (s.table_nodes > 0) {
     std::printf("  scattering per voxel through its table (multiple scattering inside it), read at kappa =");
@@ -122,8 +125,10 @@ void print_computed(const RunReport& r) {
   }
   for (const TableReport& t : r.tables) {
     if (!t.warning.empty()) std::fprintf(stderr, "nebula: warning: %s\n", t.warning.c_str());
-    std::printf("  table a=%g g=%g for %s: %s %s (%.3g s)\n", t.albedo, t.g, joined(t.bands).c_str(),
-                to_string(t.origin), t.path.c_str(), t.seconds);
+    std::printf("  table a=%g g=%g for %s: %s %s (%.3g s); its entries' median standard error %.2g%% (%llu photons "
+                "a row)\n",
+                t.albedo, t.g, joined(t.bands).c_str(), to_string(t.origin), t.path.c_str(), t.seconds, 100 * t.noise,
+                (unsigned long long)t.photons_per_row);
   }
   if (r.truth) return;
   if (r.bake.done && r.bake.reused)

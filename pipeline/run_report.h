@@ -33,6 +33,8 @@ struct TableReport {
   std::string path;                // the file read, or the cache entry
   double seconds = 0;              // reading or generating it
   std::string warning;             // a damaged or foreign cache entry that was generated again
+  double noise = 0;                // the median relative standard error of its entries (P_stderr / P)
+  uint64_t photons_per_row = 0;
 };
 
 struct BakeReport {

@@ -186,6 +186,10 @@ BandTables resolve_tables(const Scene& scene, const TableOptions& options) {
       entry = found->second;
     }
     out.per_band[b] = tables[entry];
+    if (out.report[entry].bands.empty()) {
+      out.report[entry].noise = tables[entry]->median_relative_error();
+      out.report[entry].photons_per_row = tables[entry]->photons_per_row;
+    }
     out.report[entry].bands.push_back(scene.bands[b]);
   }
   return out;

@@ -68,6 +68,12 @@ TEST_F(TableSource, ABandsFileServesThatBandOnly) {
   EXPECT_EQ(t.report[1].bands, (std::vector<std::string>{"V"}));
   EXPECT_EQ(t.report[1].origin, TableOrigin::File);
   EXPECT_EQ(t.report[1].path, path("t07.h5"));
+  // Each table's noise as its report states it: the file's entries carry 1% (make_test_table);
+  // the generated one's, from 1000 photons a row, much more.
+  EXPECT_NEAR(t.report[1].noise, 0.01, 1e-6);
+  EXPECT_EQ(t.report[1].photons_per_row, 1000003u);
+  EXPECT_GT(t.report[0].noise, 0.1);
+  EXPECT_EQ(t.report[0].photons_per_row, 1000u);
   // The second time the generated table comes from the cache.
   const BandTables again = resolve(scene("albedo = { B = 0.6, V = 0.7, R = 0.6 }\ng = { B = 0.6, V = 0.5, R = 0.6 }\n"
                                          "tables = { V = \"t07.h5\" }"));

@@ -1,5 +1,7 @@
 #include "tables/scattering_table.h"
 
+#include <algorithm>
+
 #include <cmath>
 #include <cstdio>
 
@@ -86,6 +88,16 @@ ScatteringTable ScatteringTable::make_axes(double tau_max, int n_tau, AngularBin
   t.total_stderr.assign(n_tau, 0.0);
   t.unscattered.assign(n_tau, 0.0);
   return t;
+}
+
+double ScatteringTable::median_relative_error() const {
+  std::vector<double> r;
+  r.reserve(P.size());
+  for (size_t i = 0; i < P.size() && i < P_stderr.size(); ++i)
+    if (P[i] > 0.0f) r.push_back(double(P_stderr[i]) / double(P[i]));
+  if (r.empty()) return 0.0;
+  std::nth_element(r.begin(), r.begin() + long(r.size() / 2), r.end());
+  return r[r.size() / 2];
 }
 
 double ScatteringTable::total_from_P(int i_tau) const {

@@ -69,6 +69,10 @@ struct ScatteringTable {
   // total[i] recomputed from row i of P (what check_consistency compares to).
   double total_from_P(int i_tau) const;
 
+  // The median over the entries with P > 0 of P_stderr / P: the relative
+  // Monte-Carlo noise an image reading the table carries (0 for an empty table).
+  double median_relative_error() const;
+
   // Throws Error, one line "SOURCE: FIELD: expected ..., found ...", on the
   // first inconsistency; `source` names the file or origin of the table.
   void check_consistency(const std::string& source) const;

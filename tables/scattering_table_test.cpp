@@ -64,6 +64,18 @@ TEST(ScatteringTable, TotalFromIsotropicPIsOne) {
   }
 }
 
+// The median relative standard error of the entries: make_test_table gives
+// every entry 1%; a table without scattered light has none to state.
+TEST(ScatteringTable, MedianRelativeErrorOfTheEntries) {
+  ScatteringTable t = make_test_table();
+  EXPECT_NEAR(t.median_relative_error(), 0.01, 1e-6);
+  for (size_t i = 0; i < t.P.size(); ++i)
+    if (i % 4 != 0) t.P_stderr[i] = 0.5f * t.P[i];  // three entries in four at 50%
+  EXPECT_NEAR(t.median_relative_error(), 0.5, 1e-6);
+  ScatteringTable empty = ScatteringTable::make_axes(1.0, 2, AngularBinning::UniformMu, 4);
+  EXPECT_EQ(empty.median_relative_error(), 0.0);
+}
+
 TEST(ScatteringTable, TestTableIsConsistent) {
   for (AngularBinning binning : {AngularBinning::UniformMu, AngularBinning::UniformTheta}) {
     const ScatteringTable t = make_test_table(5.0, 11, binning, 72);
