@@ -256,6 +256,31 @@ TEST(SpectralRendererTables, AnalyticTakesTheNodes) {
   EXPECT_LT(err, 5e-3);
 }
 
+// Hard cases with the table: a voxel of tau_V = 1000 (its scattering depth
+// beyond the table's range, so the lookup clamps) and a star inside the grid:
+// every method gives finite, non-negative pixels.
+TEST(SpectralRendererTables, ADenseVoxelStaysFinite) {
+  const ScatteringTable table = nebula::testing::make_test_table(5.0, 51, AngularBinning::UniformTheta, 36, 0.6);
+  auto scene = testing::noise_scene(8, 0.5f, {{0.05f, 0.05f, 0.05f}}, 16, 12);
+  scene.grid.tau_v[scene.grid.shape.index(4, 4, 4)] = 1000.0f;
+  scene.bake = bake_star_depths_cpu(scene.grid, scene.star_positions);
+  for (SpectralMethod method : {SpectralMethod::Double, SpectralMethod::Analytic, SpectralMethod::Projection,
+                                SpectralMethod::LightBasis, SpectralMethod::VoxelLight}) {
+    SpectralSettings s;
+    s.method = method;
+    s.table_nodes = 3;
+    s.depth_nodes = 256;
+    const Image img = render_with(scene, build_spectral_model(filters({"B", "V"}), {{9700}}, s), &table);
+    double peak = 0;
+    for (float v : img.pixels) {
+      ASSERT_TRUE(std::isfinite(v)) << "method " << int(method);
+      EXPECT_GE(v, -1e-6f * float(peak + 1.0));
+      peak = std::max(peak, double(v));
+    }
+    EXPECT_GT(peak, 0.0) << "method " << int(method);
+  }
+}
+
 // A table for other dust than the render's, or nodes past the limit: refused.
 TEST(SpectralRendererTables, RefusesAMismatchedTableAndTooManyNodes) {
   const ScatteringTable table = nebula::testing::make_test_table(5.0, 11, AngularBinning::UniformMu, 36, 0.3);
