@@ -5,9 +5,11 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -27,6 +29,31 @@ void expect_error(Action action, const std::vector<std::string>& pieces) {
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
   }
 }
+
+// Sets an environment variable for its lifetime and puts back what was
+// there (or unsets it) afterwards, so that one test's setting never leaks
+// into the next test of the same binary.
+class ScopedEnv {
+ public:
+  ScopedEnv(std::string name, const std::string& value) : name_(std::move(name)) {
+    const char* old = std::getenv(name_.c_str());
+    had_ = old != nullptr;
+    if (had_) saved_ = old;
+    setenv(name_.c_str(), value.c_str(), 1);
+  }
+  ~ScopedEnv() {
+    if (had_)
+      setenv(name_.c_str(), saved_.c_str(), 1);
+    else
+      unsetenv(name_.c_str());
+  }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  std::string name_, saved_;
+  bool had_ = false;
+};
 
 // A fresh folder PREFIX_PID_SUITE_TEST for the running test, removed again
 // afterwards (read-only ones too). The pid keeps parallel ctest runs and

@@ -26,20 +26,11 @@ class SpectralScene : public testing::TempDirTest {
  protected:
   // Tables generated on first use go to a cache of this test's own, with few
   // photons (their noise does not matter here: every image compared uses the same table).
+  testing::ScopedEnv cache_{"NEBULA_CACHE_DIR", path("cache")};
   void SetUp() override {
-    const char* old = std::getenv("NEBULA_CACHE_DIR");
-    saved_ = old ? old : "";
-    had_ = old != nullptr;
-    setenv("NEBULA_CACHE_DIR", path("cache").c_str(), 1);
     // A table without Monte-Carlo noise, of a real table's shape (docs/spectral.md, "Tables"): the
     // scenes below read it, so the methods' differences are theirs, not the table's noise.
     write_table(testing::make_test_table(10.0, 1001, AngularBinning::UniformTheta, 180, 0.6), path("smooth.h5"), true);
-  }
-  void TearDown() override {
-    if (had_)
-      setenv("NEBULA_CACHE_DIR", saved_.c_str(), 1);
-    else
-      unsetenv("NEBULA_CACHE_DIR");
   }
   static RenderOptions options() {
     RenderOptions o;
@@ -63,9 +54,6 @@ class SpectralScene : public testing::TempDirTest {
                       overrides);
   }
 
- private:
-  std::string saved_;
-  bool had_ = false;
 };
 
 double number_entry(const ImageMetadata& m, const std::string& key) {

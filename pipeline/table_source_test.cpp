@@ -24,18 +24,7 @@ namespace {
 
 class TableSource : public testing::TempDirTest {
  protected:
-  void SetUp() override {
-    const char* old = std::getenv("NEBULA_CACHE_DIR");
-    saved_ = old ? old : "";
-    had_ = old != nullptr;
-    setenv("NEBULA_CACHE_DIR", path("cache").c_str(), 1);
-  }
-  void TearDown() override {
-    if (had_)
-      setenv("NEBULA_CACHE_DIR", saved_.c_str(), 1);
-    else
-      unsetenv("NEBULA_CACHE_DIR");
-  }
+  testing::ScopedEnv cache_{"NEBULA_CACHE_DIR", path("cache")};
   // A table file marked as ours: 1000003 photons per row (generated ones here have 1000).
   void table_file(const std::string& name, double albedo, double g) {
     ScatteringTable t = testing::make_test_table(5.0, 11, AngularBinning::UniformTheta, 36, g);
@@ -48,10 +37,6 @@ class TableSource : public testing::TempDirTest {
                                                    "[camera]\nposition = [1, -3, 1]\nlook_at = [1, 1, 1]\n"));
   }
   BandTables resolve(const Scene& s) { return resolve_tables(s, {Backend::Cpu, 1000, false}); }
-
- private:
-  std::string saved_;
-  bool had_ = false;
 };
 
 TEST_F(TableSource, ABandsFileServesThatBandOnly) {
