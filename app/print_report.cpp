@@ -104,11 +104,15 @@ void print_spectral(const RunReport& r) {
   if (s.table_nodes > 0) {
     std::printf("  scattering per voxel through its table (multiple scattering inside it), read at kappa =");
     for (double k : s.node_kappa) std::printf(" %.3g", k);
-    std::printf(" and interpolated in kappa between; no light between voxels, no emission\n");
+    std::printf(" and interpolated in kappa between; no light between voxels\n");
   } else {
-    std::printf("  single scattering per voxel (thin-voxel HG, spectral.tables = false); no light between voxels, "
-                "no emission\n");
+    std::printf("  single scattering per voxel (thin-voxel HG, spectral.tables = false); no light between voxels\n");
   }
+  if (s.emission_lines + s.emission_continua > 0)
+    std::printf("  emission: %d line(s), %d continuum(s) ([[spectral.emission]])\n", s.emission_lines,
+                s.emission_continua);
+  else
+    std::printf("  no emission\n");
 }
 
 void print_computed(const RunReport& r) {

@@ -91,6 +91,10 @@ struct BenchScene {
   double R_V = 5.0;
   ExtinctionLaw law = ExtinctionLaw::CCM89;
   std::vector<std::pair<std::string, Passband>> filters;
+  // A scene's [[spectral.emission]] (its weight grids stay in `emission_grids`).
+  std::vector<spectral::SpectralEmission> emission;
+  std::vector<std::vector<float>> emission_grids;
+  std::vector<float> emission_scale;
 };
 
 std::string cpu_description() {
@@ -194,6 +198,14 @@ void add_spectral_bench(CLI::App* bench) {
       b.law = scene.dust.law;
       const SceneBands bands = scene_bands(scene);
       for (size_t i = 0; i < scene.bands.size(); ++i) b.filters.push_back({scene.bands[i], bands.filters[i]});
+      if (scene.spectral) {
+        for (const SpectralEmissionSpec& e : scene.spectral->emission) {
+          b.emission.push_back({e.line_nm / 1000.0, e.continuum, e.lo_nm / 1000.0, e.hi_nm / 1000.0});
+          b.emission_scale.push_back(float(e.scale));
+        }
+        b.emission_grids = scene.spectral->emission_grids;
+        b.emission_grids.resize(b.emission.size());
+      }
     } else {
       b.name = "noise cube " + std::to_string(o->size) + "^3, mean tau_V across " + to_text(o->tau);
       b.grid = noise_grid(o->size, o->tau);
@@ -237,6 +249,10 @@ void add_spectral_bench(CLI::App* bench) {
       in.g = b.g;
       in.camera = b.camera;
       in.table = table ? &*table : nullptr;
+      for (size_t c = 0; c < b.emission.size(); ++c) {  // a grid (scale applied) or tau_V times the scale
+        const bool grid = !b.emission_grids[c].empty();
+        in.emission.push_back({grid ? &b.emission_grids[c] : nullptr, grid ? 1.0f : b.emission_scale[c]});
+      }
       return in;
     };
     std::string filter_list;
@@ -246,7 +262,10 @@ void add_spectral_bench(CLI::App* bench) {
                 filter_list.c_str(), o->attenuation.c_str(),
                 table ? ("table " + o->table + " read at " + std::to_string(o->table_nodes) + " attenuations").c_str()
                       : "thin-voxel limit (no table)");
-    std::string json = "{\n  \"scene\": " + json_string(b.name) + ",\n  \"stars\": " + std::to_string(S) +
+    if (!b.emission.empty())
+      std::printf("emission: %zu component(s) from the scene's [[spectral.emission]], in every row\n", b.emission.size());
+    std::string json = "{\n  \"scene\": " + json_string(b.name) + ",\n  \"emission_components\": " +
+                       std::to_string(b.emission.size()) + ",\n  \"stars\": " + std::to_string(S) +
                        ",\n  \"width\": " + std::to_string(b.camera.width) + ",\n  \"height\": " +
                        std::to_string(b.camera.height) + ",\n  \"filters\": " + json_string(filter_list) +
                        ",\n  \"attenuation\": " + json_string(o->attenuation) + ",\n  \"table\": " +
@@ -282,7 +301,7 @@ void add_spectral_bench(CLI::App* bench) {
       ref_settings.method = spectral::SpectralMethod::Double;
       ref_settings.wavelengths = o->reference;
       Image ref;
-      const double ref_time = run(spectral::build_spectral_model(b.filters, stars, ref_settings), &ref);
+      const double ref_time = run(spectral::build_spectral_model(b.filters, stars, ref_settings, b.emission), &ref);
       const size_t plane = ref.plane_size();
       // Relative error over pixels above 1e-3 of their band's peak: largest, mean, 99th percentile.
       const auto errors = [&](const Image& img, BenchRow& row) {
@@ -312,7 +331,7 @@ void add_spectral_bench(CLI::App* bench) {
         if (s.method == spectral::SpectralMethod::Projection && S * s.basis > spectral::kMaxAccumulators) return;
         Image img;
         BenchRow r;
-        const spectral::SpectralModel m = spectral::build_spectral_model(b.filters, stars, s);
+        const spectral::SpectralModel m = spectral::build_spectral_model(b.filters, stars, s, b.emission);
         r.ms = run(m, &img) * 1e3;
         r.method = s.method == spectral::SpectralMethod::Double       ? "double"
                    : s.method == spectral::SpectralMethod::Analytic   ? "analytic"
@@ -382,8 +401,8 @@ void add_spectral_bench(CLI::App* bench) {
           rs.method = method;
           rs.basis = 4;
           if (method == spectral::SpectralMethod::Projection && S * rs.basis > spectral::kMaxAccumulators) continue;
-          const spectral::SpectralModel one = spectral::build_spectral_model(b.filters, first, rs);
-          const spectral::SpectralModel all = spectral::build_spectral_model(b.filters, stars, rs);
+          const spectral::SpectralModel one = spectral::build_spectral_model(b.filters, first, rs, b.emission);
+          const spectral::SpectralModel all = spectral::build_spectral_model(b.filters, stars, rs, b.emission);
           spectral::VoxelLightWorkspace w1, wa;
           std::vector<double> t1, ta;
           for (int r = 0; r < o->repeats + 1; ++r)

@@ -70,8 +70,8 @@ RenderOutput render_scene(const Scene& scene, const RenderOptions& options);
 
 // The spectral renderer on a scene with a [spectral] table (docs/spectral.md):
 // one plane per band, each the band's filter integrated over wavelength
-// (single scattering, the thin-voxel HG phase function; no tables, no light
-// between voxels, no emission). render_scene calls it for such scenes. Errors
+// (each voxel's scattering table read at a few attenuations, emission as
+// lines and continua; no light between voxels). render_scene calls it for such scenes. Errors
 // name the scene file and key; a model the spectral library refuses is
 // "<scene>: spectral: <reason>".
 RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& options);

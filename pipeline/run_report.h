@@ -106,7 +106,8 @@ struct SpectralReport {
   double fit_depth = 0, max_depth = 0;
   std::vector<double> elements;   // the chosen family members' optical paths a (V band)
   double basis_error = 0;         // the greedy's largest residual over its family with all elements
-  int accumulators = 0;           // numbers each ray carries
+  int accumulators = 0;           // numbers each ray carries (the emission's included)
+  int emission_lines = 0, emission_continua = 0;  // [[spectral.emission]] components
   std::vector<SpectralFilterReport> filters;
   int table_nodes = 0;            // attenuations the voxels' table is read at; 0: the thin limit (no table)
   std::vector<double> node_kappa; // their kappa = tau / tau_V

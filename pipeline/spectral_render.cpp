@@ -78,9 +78,12 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
   std::vector<spectral::SpectralStar> stars;
   for (const SceneStar& s : scene.stars) stars.push_back({s.temperature_K});
   const spectral::SpectralSettings settings = spectral_settings(scene);
+  std::vector<spectral::SpectralEmission> emission;
+  for (const SpectralEmissionSpec& e : scene.spectral->emission)
+    emission.push_back({e.line_nm / 1000.0, e.continuum, e.lo_nm / 1000.0, e.hi_nm / 1000.0});
   spectral::SpectralModel model;
   try {
-    model = spectral::build_spectral_model(filters, stars, settings);
+    model = spectral::build_spectral_model(filters, stars, settings, emission);
   } catch (const Error& e) {
     throw Error(scene.path + ": " + e.what());  // "spectral: <reason>"
   }
@@ -96,7 +99,8 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
   sr.max_depth = model.max_depth;
   sr.elements = model.element_depth;
   sr.basis_error = model.basis.error.empty() ? 0.0 : model.basis.error.back();
-  sr.accumulators = model.n_acc;
+  sr.accumulators = model.planes();
+  for (const spectral::SpectralEmission& e : model.emission) ++(e.line_um > 0 ? sr.emission_lines : sr.emission_continua);
   sr.table_nodes = table ? settings.table_nodes : 0;
   sr.node_kappa = table ? model.node_kappa : std::vector<double>{};
   for (size_t b = 0; b < filters.size(); ++b)
@@ -123,6 +127,11 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
   in.albedo = float(scene.dust.albedo.front());
   in.g = float(scene.dust.g.front());
   in.table = table.get();
+  for (size_t c = 0; c < emission.size(); ++c) {
+    const auto& grids = scene.spectral->emission_grids;  // scale applied; none: the voxel's tau_V times scale
+    const std::vector<float>* grid = c < grids.size() && !grids[c].empty() ? &grids[c] : nullptr;
+    in.emission.push_back({grid, grid ? 1.0f : float(scene.spectral->emission[c].scale)});
+  }
   in.camera = make_camera(scene.camera);
   double march_seconds = 0;
   const Image acc = spectral::render_spectral(in, o.backend, &march_seconds);
@@ -140,6 +149,7 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
       {"multiple_scattering", table ? "inside voxels (tables), none between them (spectral renderer)"
                                     : "none (spectral renderer: thin-voxel single scattering)"});
   out.metadata.entries.push_back({"spec_nodes", sr.table_nodes});
+  out.metadata.entries.push_back({"spec_emission", int(emission.size())});
   out.metadata.entries.push_back({"spec_method", sr.method});
   out.metadata.entries.push_back({"spec_basis", sr.basis});
   out.metadata.entries.push_back({"spec_atten", sr.attenuation});

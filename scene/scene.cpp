@@ -185,7 +185,21 @@ std::optional<SceneIssue> spectral_issue(const Scene& s) {
     if (band == kGreyBand)
       return SceneIssue{"bands", "the grey band has no wavelengths; the spectral renderer integrates over filters"};
   if (!s.emission.empty())
-    return SceneIssue{"spectral", "the spectral renderer has no emission yet; leave out [emission]"};
+    return SceneIssue{"emission", "holds one grid per band; the spectral renderer takes emission as lines and "
+                                  "continua ([[spectral.emission]], docs/scene.md)"};
+  for (size_t i = 0; i < p.emission.size(); ++i) {
+    const SpectralEmissionSpec& c = p.emission[i];
+    const std::string key = "spectral.emission." + std::to_string(i);
+    if (c.continuum.empty() && !(std::isfinite(c.line_nm) && c.line_nm > 0))
+      return SceneIssue{key + ".line_nm", "is " + to_text(c.line_nm) + "; must be a wavelength > 0 (nm)"};
+    for (double v : c.continuum)
+      if (!std::isfinite(v)) return SceneIssue{key + ".continuum", "holds " + to_text(v) + "; must be finite"};
+    if ((c.lo_nm != 0 || c.hi_nm != 0) && !(std::isfinite(c.lo_nm) && std::isfinite(c.hi_nm) && c.lo_nm > 0 &&
+                                             c.hi_nm > c.lo_nm))
+      return SceneIssue{key + ".range_nm", "must be [lo, hi] in nm with 0 < lo < hi"};
+    if (!(std::isfinite(c.scale) && c.scale >= 0))
+      return SceneIssue{key + ".scale", "is " + to_text(c.scale) + "; must be >= 0 and finite"};
+  }
   if (!all_equal(s.dust.albedo))
     return SceneIssue{"dust.albedo", "the spectral renderer takes one albedo for every wavelength; give one number"};
   if (!all_equal(s.dust.g))
@@ -304,7 +318,7 @@ std::optional<SceneIssue> grids_issue(const Scene& s) {
       }
     }
   }
-  if (s.stars.empty() && s.emission.empty())
+  if (s.stars.empty() && s.emission.empty() && !(s.spectral && !s.spectral->emission.empty()))
     return SceneIssue{"stars", "the scene has no stars and no emission: nothing would shine"};
   return std::nullopt;
 }

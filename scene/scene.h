@@ -129,7 +129,23 @@ struct SceneFilter {
 // (Barres 2023) instead of the band renderer's one extinction ratio and star
 // power per band. Each voxel scatters the stars' light through its scattering
 // table (multiple scattering inside the voxel) read at a few attenuations;
-// no light between voxels yet.
+// emission as lines and continua; no light between voxels yet.
+// One emission component of the spectral renderer ([[spectral.emission]];
+// docs/scene.md): j(x, lambda) = w(x) phi(lambda), added to a ray crossing
+// the voxel along one voxel edge. w: the HDF5 dataset `dataset` of `file`
+// (the density's shape), or the voxel's tau_V when no file is given, times
+// `scale`. phi: a line (a Dirac spike at line_nm; w in L_sun pc^-2 sr^-1) or
+// a continuum, the polynomial sum_k c_k lambda^k (lambda in um; w phi in
+// L_sun pc^-2 sr^-1 um^-1) on [lo_nm, hi_nm], zero outside.
+struct SpectralEmissionSpec {
+  double line_nm = 0;               // > 0: a line
+  std::vector<double> continuum;    // else: the polynomial's coefficients c_0, c_1, ...
+  double lo_nm = 0, hi_nm = 0;      // the continuum's range; 0: the basis' wavelength range
+  std::string file, dataset;        // the weight grid (resolved path), or "" for tau_V
+  double scale = 1;
+};
+constexpr int kMaxSpectralEmission = 8;
+
 struct SpectralSpec {
   std::string method = "projection";  // double, analytic, projection, light_density, voxel_light
   int basis = 4;                      // elements of the greedy basis, 1..16
@@ -142,6 +158,9 @@ struct SpectralSpec {
   double range_lo_um = 0, range_hi_um = 0;  // the basis' wavelength range; 0: the bands' span
   bool tables = true;                 // the voxel's table P(a tau_V kappa, mu); false: the thin limit tau_sct p_HG
   int table_nodes = 3;                // attenuations kappa at which the table is read, 1..4
+  std::vector<SpectralEmissionSpec> emission;  // [[spectral.emission]]
+  // One weight grid per component, scale applied (empty for tau_V weights).
+  std::vector<std::vector<float>> emission_grids;
 };
 
 // A file a scene reads: the key that names it ("scene" for the scene file

@@ -66,7 +66,9 @@ const std::initializer_list<std::string_view> kTopKeys = {"bands",  "density", "
                                                           "spectral", "animation", "display"};
 const std::initializer_list<std::string_view> kSpectralKeys = {
     "method", "basis", "wavelengths", "attenuation", "norm", "fit_depth", "max_depth", "range_um", "near_voxels",
-    "tables", "table_nodes"};
+    "tables", "table_nodes", "emission"};
+const std::initializer_list<std::string_view> kSpectralEmissionKeys = {"line_nm", "continuum", "range_nm", "file",
+                                                                       "dataset", "scale"};
 const std::initializer_list<std::string_view> kRenderKeys = {
     "levels", "multiple_scattering", "diffuse_order", "diffuse_zonal", "diffuse_cells", "diffuse_photons", "diffuse_seed",
     "samples_per_pixel"};
@@ -275,6 +277,7 @@ class Parser {
   CameraSettings parse_camera(const toml::table& root) const;
   void parse_output(const toml::table& root, Scene& scene) const;
   void parse_render(const toml::table& root, Scene& scene) const;
+  void load_spectral_emission(Scene& scene) const;
   void load_grids(const DensityPlan& density, const std::optional<EmissionPlan>& emission,
                   Scene& scene) const;
 
@@ -406,6 +409,44 @@ std::optional<SpectralSpec> Parser::parse_spectral(const toml::table& root) cons
       fail("spectral.range_um", "must be an array of 2 numbers [lo, hi] in um");
     p.range_lo_um = number((*a)[0], "spectral.range_um[0]");
     p.range_hi_um = number((*a)[1], "spectral.range_um[1]");
+  }
+  if (const toml::node* v = t.get("emission")) {
+    const toml::array* a = v->as_array();
+    if (a == nullptr) fail("spectral.emission", "must be an array of tables ([[spectral.emission]])");
+    if (a->size() > size_t(kMaxSpectralEmission))
+      fail("spectral.emission", std::to_string(a->size()) + " components; at most " +
+                                    std::to_string(kMaxSpectralEmission));
+    for (size_t i = 0; i < a->size(); ++i) {
+      const std::string key = "spectral.emission." + std::to_string(i);
+      const toml::table& e = table_at((*a)[i], key);
+      known_keys(e, key, kSpectralEmissionKeys);
+      SpectralEmissionSpec c;
+      const toml::node* line = e.get("line_nm");
+      const toml::node* continuum = e.get("continuum");
+      if ((line == nullptr) == (continuum == nullptr))
+        fail(key, "give exactly one of line_nm (a line) and continuum (polynomial coefficients)");
+      if (line) c.line_nm = number(*line, key + ".line_nm");
+      if (continuum) {
+        const toml::array* coefficients = continuum->as_array();
+        if (coefficients == nullptr || coefficients->empty() || coefficients->size() > 8)
+          fail(key + ".continuum", "must be an array of 1 to 8 numbers (c_0, c_1, ... of sum c_k lambda^k, lambda in um)");
+        for (size_t k = 0; k < coefficients->size(); ++k)
+          c.continuum.push_back(number((*coefficients)[k], key + ".continuum[" + std::to_string(k) + "]"));
+      }
+      if (const toml::node* r = e.get("range_nm")) {
+        const toml::array* range = r->as_array();
+        if (range == nullptr || range->size() != 2) fail(key + ".range_nm", "must be an array of 2 numbers [lo, hi] in nm");
+        if (line) fail(key + ".range_nm", "applies to a continuum; a line has no range");
+        c.lo_nm = number((*range)[0], key + ".range_nm[0]");
+        c.hi_nm = number((*range)[1], key + ".range_nm[1]");
+      }
+      if (const toml::node* f = e.get("file")) c.file = data_path(*f, key + ".file");
+      if (const toml::node* d = e.get("dataset")) c.dataset = string(*d, key + ".dataset");
+      if (c.file.empty() != c.dataset.empty())
+        fail(key, "file and dataset go together (the weight grid); leave both out to weight by the voxel's tau_V");
+      if (const toml::node* sc = e.get("scale")) c.scale = number(*sc, key + ".scale");
+      p.emission.push_back(std::move(c));
+    }
   }
   return p;
 }
@@ -887,6 +928,30 @@ void Parser::load_grids(const DensityPlan& density, const std::optional<Emission
   }
 }
 
+// The spectral emission components' weight grids (files named in
+// [[spectral.emission]]), their scale applied; checked before any is used.
+void Parser::load_spectral_emission(Scene& scene) const {
+  SpectralSpec& p = *scene.spectral;
+  p.emission_grids.assign(p.emission.size(), {});
+  const GridShape& s = scene.density.shape;
+  for (size_t i = 0; i < p.emission.size(); ++i) {
+    const SpectralEmissionSpec& c = p.emission[i];
+    const std::string key = "spectral.emission." + std::to_string(i);
+    if (!(std::isfinite(c.scale) && c.scale >= 0)) fail(key + ".scale", "is " + number_text(c.scale) + "; must be >= 0 and finite");
+    if (c.file.empty()) continue;
+    try {
+      check_grid_size("an emission weight grid", uint64_t(s.nx), uint64_t(s.ny), uint64_t(s.nz), 2 * sizeof(float));
+      p.emission_grids[i] = load_emission_hdf5(c.file, c.dataset, s);
+    } catch (const Error& e) {
+      fail(key + ".file", e.what());
+    }
+    for (float& v : p.emission_grids[i]) {
+      v = static_cast<float>(v * c.scale);
+      if (!std::isfinite(v)) fail(key + ".scale", "makes a weight overflow a float (inf)");
+    }
+  }
+}
+
 Scene Parser::build(toml::table& root, const Scene* reuse_grids) {
   known_keys(root, "", kTopKeys);
   Scene scene;
@@ -900,6 +965,9 @@ Scene Parser::build(toml::table& root, const Scene* reuse_grids) {
   if (axial && root.get("emission") != nullptr)
     fail("emission", "applies to [density] grids; an axial map carries its own emission (axial.emission_prefix, "
                      "axial.emission_channels)");
+  if (scene.spectral && root.get("emission") != nullptr)
+    fail("emission", "holds one grid per band; the spectral renderer takes emission as lines and continua "
+                     "([[spectral.emission]], docs/scene.md)");
   DensityPlan density;
   if (axial) {
     density.kind = DensityKind::Hdf5;  // stars need an explicit position
@@ -910,7 +978,8 @@ Scene Parser::build(toml::table& root, const Scene* reuse_grids) {
   const std::optional<EmissionPlan> emission = axial ? std::nullopt : parse_emission(root);
   scene.dust = parse_dust(root, scene.bands);
   scene.stars = parse_stars(root, density);
-  if (scene.stars.empty() && !emission && !axial)
+  const bool spectral_emission = scene.spectral && !scene.spectral->emission.empty();
+  if (scene.stars.empty() && !emission && !axial && !spectral_emission)
     fail("stars", "missing: a scene needs at least one [[stars]] entry (or an [emission] grid)");
   if (axial) {
     // Stars on the axis keep the illumination axisymmetric (DESIGN.md section 3).
@@ -938,6 +1007,10 @@ Scene Parser::build(toml::table& root, const Scene* reuse_grids) {
   if (emission) scene.inputs.push_back({"emission.file", emission->path});
   if (axial && !scene.axial->path.empty()) scene.inputs.push_back({"axial." + scene.axial->source, scene.axial->path});
   for (const SceneFilter& f : scene.filters) scene.inputs.push_back({"filters." + f.name, f.path});
+  if (scene.spectral)
+    for (size_t i = 0; i < scene.spectral->emission.size(); ++i)
+      if (!scene.spectral->emission[i].file.empty())
+        scene.inputs.push_back({"spectral.emission." + std::to_string(i) + ".file", scene.spectral->emission[i].file});
   for (size_t b = 0; b < scene.dust.table_files.size(); ++b)
     if (!scene.dust.table_files[b].empty())
       scene.inputs.push_back({"dust.tables." + scene.bands[b], scene.dust.table_files[b]});
@@ -958,6 +1031,7 @@ Scene Parser::build(toml::table& root, const Scene* reuse_grids) {
   } else if (!axial) {
     load_grids(density, emission, scene);  // the expensive part, last
   }
+  if (scene.spectral && !axial) load_spectral_emission(scene);
   if (const auto issue = scene_detail::grids_issue(scene)) fail(issue->key, issue->reason);
   return scene;
 }

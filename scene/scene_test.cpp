@@ -718,6 +718,55 @@ TEST_F(SceneFile, UserFiltersAndTheSpectralTableAreReadAndChecked) {
   refused("override", kBase, {"spectral.basis", "1..16", "override 'spectral.basis=0'"}, {"spectral.basis=0"});
 }
 
+// [[spectral.emission]]: lines and continua, weighted by the voxel's tau_V or
+// by a grid from an HDF5 file (scale applied at load); each bad value refused
+// naming its component's key.
+TEST_F(SceneFile, SpectralEmissionComponentsAreReadAndChecked) {
+  H5Dataset ha;
+  ha.name = "ha";
+  ha.dims = {16, 16, 16};
+  ha.values.assign(4096, 0.0);
+  ha.values[7] = 2.0;
+  write_h5(path("glow.h5"), {ha});
+  const std::string s = std::string(kBase) + "[spectral]\n";
+  const Scene scene = load_scene(write_text("glow.toml", s + "[[spectral.emission]]\nline_nm = 656.28\nfile = \"glow.h5\"\n"
+                                                             "dataset = \"ha\"\nscale = 0.5\n"
+                                                             "[[spectral.emission]]\ncontinuum = [0.1, 0.2]\n"
+                                                             "range_nm = [500, 700]\n"));
+  ASSERT_EQ(scene.spectral->emission.size(), 2u);
+  EXPECT_EQ(scene.spectral->emission[0].line_nm, 656.28);
+  EXPECT_EQ(scene.spectral->emission[1].continuum, (std::vector<double>{0.1, 0.2}));
+  EXPECT_EQ(scene.spectral->emission[1].hi_nm, 700.0);
+  ASSERT_EQ(scene.spectral->emission_grids.size(), 2u);
+  EXPECT_EQ(scene.spectral->emission_grids[0][7], 1.0f);  // 2 x scale 0.5
+  EXPECT_TRUE(scene.spectral->emission_grids[1].empty());  // tau_V weights
+  bool listed = false;
+  for (const SceneInput& in : scene.inputs) listed = listed || in.key == "spectral.emission.0.file";
+  EXPECT_TRUE(listed);
+  // Emission alone lights a spectral scene: no star needed.
+  std::string starless = s;
+  starless.erase(starless.find("[[stars]]"), starless.find("[camera]") - starless.find("[[stars]]"));
+  EXPECT_NO_THROW(load_scene(write_text("starless.toml", starless + "[[spectral.emission]]\nline_nm = 500\n")));
+
+  refused("both", s + "[[spectral.emission]]\nline_nm = 500\ncontinuum = [1]\n", {"spectral.emission.0", "exactly one"});
+  refused("neither", s + "[[spectral.emission]]\nscale = 2\n", {"spectral.emission.0", "exactly one"});
+  refused("line", s + "[[spectral.emission]]\nline_nm = -5\n", {"spectral.emission.0.line_nm", "> 0"});
+  refused("empty", s + "[[spectral.emission]]\ncontinuum = []\n", {"spectral.emission.0.continuum", "1 to 8"});
+  refused("range", s + "[[spectral.emission]]\ncontinuum = [1]\nrange_nm = [700, 500]\n",
+          {"spectral.emission.0.range_nm", "0 < lo < hi"});
+  refused("line_range", s + "[[spectral.emission]]\nline_nm = 500\nrange_nm = [400, 600]\n",
+          {"spectral.emission.0.range_nm", "a line"});
+  refused("scale", s + "[[spectral.emission]]\nline_nm = 500\nscale = -1\n", {"spectral.emission.0.scale", ">= 0"});
+  refused("dataset", s + "[[spectral.emission]]\nline_nm = 500\nfile = \"glow.h5\"\n",
+          {"spectral.emission.0", "file and dataset"});
+  refused("missing", s + "[[spectral.emission]]\nline_nm = 500\nfile = \"no.h5\"\ndataset = \"ha\"\n",
+          {"spectral.emission.0.file", "no.h5"});
+  refused("key", s + "[[spectral.emission]]\nline_nm = 500\nwidth_nm = 1\n", {"spectral.emission.0.width_nm", "unknown key"});
+  refused("table", s + "emission = 3\n", {"spectral.emission", "array of tables"});
+  write_text("e.h5", "placeholder");
+  refused("band_emission", std::string("[emission]\nfile = \"e.h5\"\n") + s, {"emission", "[[spectral.emission]]"});
+}
+
 const char* kAxial = R"(
 [axial]
 synthetic = "shells"

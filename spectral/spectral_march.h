@@ -57,6 +57,19 @@ constexpr int kMaxAccumulators = 64;  // per ray: registers on the GPU
 constexpr int kMaxBasis = 16;
 constexpr int kMaxVoxelLightStars = 32;  // VoxelLight: one bit per star in a voxel's near-star mask
 constexpr int kMaxTableNodes = 4;        // attenuations at which a pair reads the table
+constexpr int kMaxEmission = 8;          // emission components
+constexpr int kMaxEmissionPlanes = 32;   // emission numbers per ray
+
+// One emission component in the march (add_emission): its weight per voxel
+// (null: the voxel's tau_V) times scale, and its first plane among the
+// emission's (after the n_acc star planes).
+struct SpectralEmissionView {
+  const float* weight = nullptr;
+  float scale = 1;
+  int plane = 0;
+  bool line = false;
+  float line_kappa = 0;  // a line's attenuation kappa(lambda_l)
+};
 
 struct SpectralStarView {
   Vec3 position;
@@ -110,6 +123,19 @@ struct SpectralSceneView {
   int n_powers = 1;
   float node_kappa[kMaxTableNodes] = {};
   float node_to_power[kMaxTableNodes * kMaxTableNodes] = {};
+  // Emission (docs/spectral.md, "Emission"): a voxel adds w(x) phi(lambda) seen
+  // through e^(-kappa D_eye), D_eye the V-band depth from the eye to its entry.
+  // A line's plane gathers w e^(-kappa_l D) (exact; resolved with S_f(lambda_l));
+  // a continuum's planes: Double, per filter sum_i emission_q e^(-kappa_i D);
+  // Analytic, per filter the closed form of S_f phi e^(-C_T D / lambda) from
+  // the emission's piecewise cubics; the basis methods, per element c_j(D) of
+  // e^(-kappa D) (emission_coeff [d][j]), resolved with integral S_f phi b_j.
+  int n_emission = 0, n_emission_planes = 0;
+  SpectralEmissionView emission[kMaxEmission];
+  const float* emission_q = nullptr;               // Double: [component][filter][lambda]
+  const double* emission_breaks = nullptr;         // Analytic: [component][filter][segments + 1]
+  const double* emission_coefficients = nullptr;   // Analytic: [component][filter][segments][degree + 1]
+  const float* emission_coeff = nullptr;           // basis methods: [d][j]
 };
 
 // Henyey-Greenstein phase function per steradian.
@@ -203,6 +229,57 @@ NEBULA_HD void store_accumulators(const SpectralSceneView& s, Acc& acc, float* o
   for_each_index<Acc::kRows>(accumulator_rows(s), [&](int r) {
     for_each_index<Acc::kCols>(cols, [&](int c) { out[size_t(r * cols + c) * stride] = acc(r, c); });
   });
+}
+
+// Emission: the voxel's components seen through V-band depth D from the eye,
+// weighted by `fraction` of a voxel edge crossed, into the emission planes em.
+template <SpectralMethod kMethod>
+NEBULA_HD void add_emission(const SpectralSceneView& s, size_t cell, float tau_v, float fraction, float D, float* em) {
+  for (int c = 0; c < s.n_emission; ++c) {
+    const SpectralEmissionView& e = s.emission[c];
+    const float w = fraction * e.scale * (e.weight ? e.weight[cell] : tau_v);
+    if (!(w > 0.0f)) continue;
+    float* out = em + e.plane;
+    if (e.line) {
+      out[0] += w * expf(-e.line_kappa * D);
+      continue;
+    }
+    if constexpr (kMethod == SpectralMethod::Double) {
+      const float* q = s.emission_q + size_t(c) * s.n_acc * s.n_lambda;
+      for (int i = 0; i < s.n_lambda; ++i) {
+        const float t = w * expf(-s.kappa[i] * D);
+        for (int f = 0; f < s.n_acc; ++f) out[f] += q[f * s.n_lambda + i] * t;
+      }
+    } else if constexpr (kMethod == SpectralMethod::Analytic) {
+      // integral S_f phi e^(-C_T D / lambda) = sum_k c_k I_k(C_T D), S_f phi piecewise cubic.
+      const double a = s.C_T * double(D);
+      for (int f = 0; f < s.n_acc; ++f) {
+        const size_t cf = size_t(c) * s.n_acc + f;
+        const double* b = s.emission_breaks + cf * (s.segments + 1);
+        const double* k_c = s.emission_coefficients + cf * s.segments * (s.degree + 1);
+        double sum = 0.0;
+        for (int seg = 0; seg < s.segments; ++seg)
+          for (int k = 0; k <= s.degree; ++k) {
+            const double ck = k_c[seg * (s.degree + 1) + k];
+            if (ck != 0.0) sum += ck * power_exp_integral(k, a, b[seg], b[seg + 1]);
+          }
+        out[f] += w * float(sum);
+      }
+    } else {
+      const float x = D / s.depth_step;
+      if (!(x < float(s.n_depth - 1))) continue;  // beyond the table: below the transmittance cut
+      const int d0 = int(x);
+      const float fd = x - float(d0);
+      const int N = s.n_basis;
+      const float* c0 = s.emission_coeff + size_t(d0) * N;
+      for (int j = 0; j < N; ++j) out[j] += w * (c0[j] + fd * (c0[N + j] - c0[j]));
+    }
+  }
+}
+
+// The emission planes into out[(n_acc + k) * stride] (after the star planes).
+NEBULA_HD void store_emission(const SpectralSceneView& s, const float* em, float* out, size_t stride) {
+  for (int k = 0; k < s.n_emission_planes; ++k) out[size_t(s.n_acc + k) * stride] = em[k];
 }
 
 // Adds the pair's light in every accumulator (the method a template argument,
@@ -525,12 +602,14 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
 }
 
 // One ray: the accumulators (n_acc of them) before the resolve.
+// em: the emission's planes (n_emission_planes of them; null without emission).
 template <SpectralMethod kMethod, class Acc>
-NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir, Acc& acc) {
+NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir, Acc& acc, float* em = nullptr) {
   acc.cols = accumulator_cols(s);
   for_each_index<Acc::kRows>(accumulator_rows(s), [&](int r) {
     for_each_index<Acc::kCols>(acc.cols, [&](int c) { acc(r, c) = 0.0f; });
   });
+  for (int k = 0; k < s.n_emission_planes; ++k) em[k] = 0.0f;
   const GridShape& g = s.density.shape;
   const Vec3 span = g.upper() - g.origin;
   const float far = length(origin - (g.origin + 0.5f * span)) + length(span) + g.voxel;
@@ -591,6 +670,7 @@ NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir,
         add_pair<kMethod>(s, k, pair_weights(s, w, tau_v, mu), s.stars[k].depth_v[cell] + eye_depth, acc);
       });
     }
+    if (s.n_emission > 0) add_emission<kMethod>(s, cell, tau_v, fraction, eye_depth, em);
     t += chord;
     eye_depth += tau_v * fraction;
     return eye_depth < s.max_eye_depth;

@@ -58,7 +58,56 @@ void set_table_nodes(SpectralModel& m, int nodes, double kappa_min, double kappa
     for (int k = 0; k < nodes; ++k) m.node_to_power.push_back(inverse(p, k));
 }
 
+void build_emission(SpectralModel& m);
+void add_emission_resolve(SpectralModel& m);
+
+// Emission components checked against the model's range, their continua's
+// ranges resolved (0, 0: the basis' range; clipped to it).
+std::vector<SpectralEmission> checked_emission(const SpectralModel& m, std::vector<SpectralEmission> emission) {
+  const auto nm = [](double um) { return to_text(um * 1000.0); };
+  const std::string span = "[" + nm(m.lo_um) + ", " + nm(m.hi_um) + "] nm";
+  if (emission.size() > size_t(kMaxEmission))
+    throw Error("spectral.emission: " + std::to_string(emission.size()) + " components; at most " +
+                std::to_string(kMaxEmission));
+  for (size_t i = 0; i < emission.size(); ++i) {
+    SpectralEmission& e = emission[i];
+    const std::string key = "spectral.emission." + std::to_string(i);
+    if (e.line_um > 0) {
+      if (e.line_um < m.lo_um || e.line_um > m.hi_um)
+        throw Error(key + ".line_nm: " + nm(e.line_um) + " nm is outside the filters' span " + span +
+                    " (the basis' range: spectral.range_um widens it)");
+      continue;
+    }
+    if (e.continuum.empty()) throw Error(key + ": neither a line nor a continuum");
+    const bool given = e.lo_um > 0 || e.hi_um > 0;
+    const double lo = given ? std::max(e.lo_um, m.lo_um) : m.lo_um, hi = given ? std::min(e.hi_um, m.hi_um) : m.hi_um;
+    if (!(lo < hi))
+      throw Error(key + ".range_nm: [" + nm(e.lo_um) + ", " + nm(e.hi_um) + "] nm misses the filters' span " + span);
+    e.lo_um = lo;
+    e.hi_um = hi;
+    double largest = 0.0;
+    for (int k = 0; k <= 1000; ++k) largest = std::max(largest, std::fabs(e.phi(lo + (hi - lo) * k / 1000.0)));
+    for (int k = 0; k <= 1000; ++k) {
+      const double l = lo + (hi - lo) * k / 1000.0;
+      if (e.phi(l) < -1e-9 * largest)
+        throw Error(key + ".continuum: is " + to_text(e.phi(l)) + " at " + nm(l) +
+                    " nm; emission cannot be negative on its range");
+    }
+  }
+  return emission;
+}
+
 }  // namespace
+
+double SpectralEmission::phi(double lambda) const {
+  if (line_um > 0 || lambda < lo_um || lambda > hi_um) return 0.0;
+  double v = 0.0, x = 1.0;
+  for (double c : continuum) {
+    v += c * x;
+    x *= lambda;
+  }
+  return v;
+}
 
 double SpectralStar::shape(double lambda) const {
   if (table) return (*table)(lambda);
@@ -71,7 +120,8 @@ double SpectralModel::kappa_at(double lambda) const {
 }
 
 SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Passband>>& filters,
-                                   const std::vector<SpectralStar>& stars, const SpectralSettings& settings) {
+                                   const std::vector<SpectralStar>& stars, const SpectralSettings& settings,
+                                   const std::vector<SpectralEmission>& emission) {
   if (filters.empty()) throw Error("spectral: no filter");
   if (settings.basis < 1 || settings.basis > 16)
     throw Error("spectral: the basis size is " + std::to_string(settings.basis) + "; must be in 1..16");
@@ -126,6 +176,7 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
     m.lo_um = settings.lo_um;
     m.hi_um = settings.hi_um;
   }
+  m.emission = checked_emission(m, emission);
   m.grid = WavelengthGrid::uniform(m.lo_um, m.hi_um, settings.grid_nodes);
   double kappa_min = 1e30, kappa_max = 0;
   for (double l : m.grid.lambda) {
@@ -241,16 +292,112 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
                       " K is outside the light-density basis' range [2000, 60000] K");
         m.temperature_u.push_back(float(std::clamp(u, 0.0, double(m.n_temperature - 1))));
       }
+      build_emission(m);  // before set_filters, which adds the emission's resolve columns
       set_filters(m, filters);
       return m;
     }
   }
   m.resolve.assign(size_t(F) * m.n_acc, 0.0f);
   for (int f = 0; f < F; ++f) m.resolve[size_t(f) * m.n_acc + f] = 1.0f;
+  build_emission(m);
+  add_emission_resolve(m);
   return m;
 }
 
 namespace {
+
+// The emission's planes and tables (SpectralModel::emission_*): a line one
+// plane, a continuum one per filter (Double, Analytic) or per basis element.
+void build_emission(SpectralModel& m) {
+  const SpectralMethod method = m.settings.method;
+  const bool per_filter = method == SpectralMethod::Double || method == SpectralMethod::Analytic;
+  const int F = int(m.filters.size()), n = m.basis.size();
+  m.emission_plane.clear();
+  m.n_emission_planes = 0;
+  for (const SpectralEmission& e : m.emission) {
+    m.emission_plane.push_back(m.n_emission_planes);
+    m.n_emission_planes += e.line_um > 0 ? 1 : per_filter ? F : n;
+  }
+  if (m.n_emission_planes > kMaxEmissionPlanes)
+    throw Error("spectral.emission: " + std::to_string(m.n_emission_planes) + " numbers per ray (a line 1, a continuum " +
+                (per_filter ? "1 per filter" : "1 per basis element") + "); at most " +
+                std::to_string(kMaxEmissionPlanes));
+  m.emission_q.clear();
+  m.emission_breaks.clear();
+  m.emission_coefficients.clear();
+  m.emission_coeff.clear();
+  if (m.emission.empty()) return;
+  if (method == SpectralMethod::Double) {
+    const int M = m.settings.wavelengths;
+    const double step = (m.hi_um - m.lo_um) / M;
+    for (const SpectralEmission& e : m.emission)
+      for (int f = 0; f < F; ++f)
+        for (int i = 0; i < M; ++i) {
+          const double l = m.lo_um + (i + 0.5) * step;
+          m.emission_q.push_back(float(m.filters[f](l) * e.phi(l) * step));
+        }
+  } else if (method == SpectralMethod::Analytic) {
+    // S_f phi as piecewise cubics (global powers of lambda) on the overlap of the
+    // filter and the continuum's range; a line (or no overlap): zeros.
+    const int segments = m.segments, coefficients = segments * (kMaxPolynomialDegree + 1);
+    for (const SpectralEmission& e : m.emission)
+      for (int f = 0; f < F; ++f) {
+        const PiecewisePolynomial& filter = m.filters[f];
+        const double lo = std::max(filter.breaks.front(), e.lo_um), hi = std::min(filter.breaks.back(), e.hi_um);
+        if (e.line_um > 0 || !(lo < hi)) {
+          m.emission_breaks.insert(m.emission_breaks.end(), segments + 1, filter.breaks.front());
+          m.emission_coefficients.insert(m.emission_coefficients.end(), coefficients, 0.0);
+          continue;
+        }
+        const PiecewisePolynomial p = fit_function([&](double l) { return filter(l) * e.phi(l); }, lo, hi, segments);
+        m.emission_breaks.insert(m.emission_breaks.end(), p.breaks.begin(), p.breaks.end());
+        m.emission_coefficients.insert(m.emission_coefficients.end(), p.coefficients.begin(), p.coefficients.end());
+      }
+  } else if (method == SpectralMethod::LightBasis) {
+    // e^(-kappa D) on the basis (the other basis methods' first coefficient block is that table).
+    std::vector<double> f(m.grid.lambda.size());
+    for (int d = 0; d < m.settings.depth_nodes; ++d) {
+      for (size_t i = 0; i < f.size(); ++i) f[i] = std::exp(-m.kappa_grid[i] * d * m.depth_step);
+      for (double c : m.settings.relative ? project_relative(m.grid, m.basis, f) : project(m.grid, m.basis, f))
+        m.emission_coeff.push_back(float(c));
+    }
+  }
+}
+
+// Widens the resolve (its n_acc star columns made) by the emission's planes: a
+// line's column S_f(lambda_l); a continuum's, per filter (Double, Analytic) 1
+// for its own filter, per basis element integral S_f phi b_j.
+void add_emission_resolve(SpectralModel& m) {
+  if (m.n_emission_planes == 0) return;
+  const int F = int(m.filters.size()), A = m.n_acc, W = m.planes();
+  const bool per_filter =
+      m.settings.method == SpectralMethod::Double || m.settings.method == SpectralMethod::Analytic;
+  std::vector<float> r(size_t(F) * W, 0.0f);
+  for (int f = 0; f < F; ++f)
+    for (int k = 0; k < A; ++k) r[size_t(f) * W + k] = m.resolve[size_t(f) * A + k];
+  for (size_t c = 0; c < m.emission.size(); ++c) {
+    const SpectralEmission& e = m.emission[c];
+    const int plane = A + m.emission_plane[c];
+    for (int f = 0; f < F; ++f) {
+      float* row = &r[size_t(f) * W];
+      if (e.line_um > 0) {
+        row[plane] = float(m.filters[f](e.line_um));
+      } else if (per_filter) {
+        row[plane + f] = 1.0f;
+      } else {
+        for (int j = 0; j < m.basis.size(); ++j) {
+          double sum = 0.0;
+          for (size_t i = 0; i < m.grid.lambda.size(); ++i) {
+            const double l = m.grid.lambda[i];
+            sum += m.grid.weight[i] * m.filters[f](l) * e.phi(l) * m.basis.phi[j][i];
+          }
+          row[plane + j] = float(sum);
+        }
+      }
+    }
+  }
+  m.resolve = std::move(r);
+}
 
 // VoxelLight: Q_fj(star, D) = integral S_f kappa s e^(-kappa D) phi_j on the
 // inner products' grid, at the coefficient table's depths; the resolve is the
@@ -310,6 +457,7 @@ void set_filters(SpectralModel& m, const std::vector<std::pair<std::string, Pass
   }
   if (voxel) {
     build_star_tables(m);
+    add_emission_resolve(m);
     return;
   }
   const int F = int(filters.size()), n = m.basis.size(), S = int(m.stars.size());
@@ -326,6 +474,7 @@ void set_filters(SpectralModel& m, const std::vector<std::pair<std::string, Pass
         }
         m.resolve[size_t(fi) * m.n_acc + s * n + j] = float(sum);
       }
+  add_emission_resolve(m);
 }
 
 SpectralSceneView view_of(const SpectralModel& m) {
@@ -352,7 +501,35 @@ SpectralSceneView view_of(const SpectralModel& m) {
   const int K = int(m.node_kappa.size());
   for (int p = 0; p < K; ++p)
     for (int k = 0; k < K; ++k) v.node_to_power[p * kMaxTableNodes + k] = float(m.node_to_power[size_t(p) * K + k]);
+  // Emission: the spectra's tables; each component's weight is the renderer's.
+  v.n_emission = int(m.emission.size());
+  v.n_emission_planes = m.n_emission_planes;
+  for (int c = 0; c < v.n_emission; ++c) {
+    SpectralEmissionView& e = v.emission[c];
+    e.plane = m.emission_plane[size_t(c)];
+    e.line = m.emission[size_t(c)].line_um > 0;
+    e.line_kappa = e.line ? float(m.kappa_at(m.emission[size_t(c)].line_um)) : 0.0f;
+  }
+  v.emission_q = m.emission_q.data();
+  v.emission_breaks = m.emission_breaks.data();
+  v.emission_coefficients = m.emission_coefficients.data();
+  v.emission_coeff = m.emission_coeff.empty() ? m.coeff.data() : m.emission_coeff.data();
   return v;  // n_nodes stays 0 (the thin limit) until the renderer is given a table
+}
+
+double emission_reference(const SpectralModel& m, int filter, int component, double D) {
+  const PiecewisePolynomial& S = m.filters[size_t(filter)];
+  const SpectralEmission& e = m.emission[size_t(component)];
+  if (e.line_um > 0) return S(e.line_um) * std::exp(-m.kappa_at(e.line_um) * D);
+  const double lo = std::max(S.breaks.front(), e.lo_um), hi = std::min(S.breaks.back(), e.hi_um);
+  double sum = 0.0;
+  for (int seg = 0; seg < S.segments(); ++seg) {
+    const double a = std::max(S.breaks[seg], lo), b = std::min(S.breaks[seg + 1], hi);
+    for (int k = 0; a < b && k < 8; ++k)
+      sum += gauss5([&](double l) { return S(l) * e.phi(l) * std::exp(-m.kappa_at(l) * D); }, a + (b - a) * k / 8,
+                    a + (b - a) * (k + 1) / 8);
+  }
+  return sum;
 }
 
 double reference_integral(const SpectralModel& m, int filter, const SpectralStar& star, double D) {

@@ -71,6 +71,19 @@ struct SpectralStar {
   double shape(double lambda_um) const;
 };
 
+// An emission component's spectrum (docs/spectral.md, "Emission"): the voxel
+// adds w(x) phi(lambda) to a ray crossing it along one voxel edge, w from the
+// renderer's inputs. A line: phi = delta(lambda - line_um), so w is the line's
+// radiance (L_sun pc^-2 sr^-1). A continuum: phi = sum_k c_k lambda^k (lambda
+// in um) on [lo_um, hi_um] (0, 0: the basis' range), zero outside; w phi in
+// L_sun pc^-2 sr^-1 um^-1.
+struct SpectralEmission {
+  double line_um = 0;              // > 0: a line
+  std::vector<double> continuum;   // else: c_0, c_1, ...
+  double lo_um = 0, hi_um = 0;
+  double phi(double lambda_um) const;  // a continuum's spectrum (0 outside its range)
+};
+
 struct SpectralModel {
   SpectralSettings settings;
   std::vector<std::string> filter_names;
@@ -101,6 +114,15 @@ struct SpectralModel {
   // powers of kappa ([p][m]); n_powers blocks in coeff and star_coeff.
   std::vector<double> node_kappa, node_to_power;
   int n_powers = 1;
+  // Emission: its planes follow the n_acc star planes (the resolve's columns
+  // n_acc .. n_acc + n_emission_planes - 1; spectral_march.h, add_emission).
+  std::vector<SpectralEmission> emission;  // lo_um, hi_um resolved
+  int n_emission_planes = 0;
+  std::vector<int> emission_plane;     // per component: its first plane (after the star planes)
+  std::vector<float> emission_q;       // Double: [component][filter][lambda] S_f phi dlambda
+  std::vector<double> emission_breaks, emission_coefficients;  // Analytic: S_f phi per [component][filter]
+  std::vector<float> emission_coeff;   // LightBasis: e^(-kappa D) on the basis, [d][j] (else coeff's first block)
+  int planes() const { return n_acc + n_emission_planes; }
   double kappa_at(double lambda_um) const;
 };
 
@@ -109,8 +131,12 @@ struct SpectralModel {
 // not positive, Analytic with the Law attenuation, LightBasis with a
 // tabulated star, VoxelLight with more than 32 stars or near_voxels < 0,
 // table_nodes outside 0..4.
+// Emission errors name "spectral.emission.<i>": a line outside the basis'
+// range, a continuum range outside it or negative somewhere on its range,
+// more than kMaxEmissionPlanes planes per ray.
 SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Passband>>& filters,
-                                   const std::vector<SpectralStar>& stars, const SpectralSettings& settings);
+                                   const std::vector<SpectralStar>& stars, const SpectralSettings& settings,
+                                   const std::vector<SpectralEmission>& emission = {});
 
 // New filters on the same basis and tables (Projection, LightBasis): only the
 // resolve matrix changes, no march or bake (Barrès' filters changed at run
@@ -126,5 +152,8 @@ SpectralSceneView view_of(const SpectralModel& m);
 // and star (adaptive Gauss-Legendre on the fitted S_f): the reference the
 // methods are measured against.
 double reference_integral(const SpectralModel& m, int filter, const SpectralStar& star, double D);
+// The same for emission component c seen through V-band depth D: integral
+// S_f phi e^(-kappa D) dlambda (a line: S_f(lambda_l) e^(-kappa_l D)).
+double emission_reference(const SpectralModel& m, int filter, int component, double D);
 
 }  // namespace nebula::spectral

@@ -20,6 +20,12 @@ void check(const SpectralRenderInputs& in) {
   for (const SpectralLight& l : in.lights)
     if (!l.depth_v || l.depth_v->size() != in.density->shape.count())
       throw Error("spectral render: a star has no baked depth for this grid");
+  if (in.emission.size() != in.model->emission.size())
+    throw Error("spectral render: the model has " + std::to_string(in.model->emission.size()) +
+                " emission components, got " + std::to_string(in.emission.size()) + " weights");
+  for (const SpectralEmissionWeight& e : in.emission)
+    if (e.grid && e.grid->size() != in.density->shape.count())
+      throw Error("spectral render: an emission weight grid does not have the density's shape");
   if (in.table && in.model->settings.table_nodes > 0 &&
       (std::fabs(in.table->albedo - in.albedo) > 1e-6 || std::fabs(in.table->g - in.g) > 1e-6))
     throw Error("spectral render: the table is for albedo " + to_text(in.table->albedo) + ", g " +
@@ -33,6 +39,13 @@ void set_table(SpectralSceneView& view, const SpectralRenderInputs& in, const fl
   view.table.P = P;
   view.table.C = nullptr;  // only lookup_at is used
   view.n_nodes = in.model->settings.table_nodes;
+}
+
+void set_emission(SpectralSceneView& view, const SpectralRenderInputs& in, const std::vector<const float*>& grids) {
+  for (size_t c = 0; c < in.emission.size(); ++c) {
+    view.emission[c].weight = grids[c];
+    view.emission[c].scale = in.emission[c].scale;
+  }
 }
 
 Image render_spectral(const SpectralRenderInputs& in, Backend backend, double* seconds) {
@@ -55,8 +68,11 @@ Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds) {
   view.g = in.g;
   view.footprint = in.camera.footprint();
   set_table(view, in, in.table ? in.table->P.data() : nullptr);
+  std::vector<const float*> grids;
+  for (const SpectralEmissionWeight& e : in.emission) grids.push_back(e.grid ? e.grid->data() : nullptr);
+  set_emission(view, in, grids);
   std::vector<std::string> names;
-  for (int k = 0; k < m.n_acc; ++k) names.push_back("acc" + std::to_string(k));
+  for (int k = 0; k < m.planes(); ++k) names.push_back("acc" + std::to_string(k));
   Image image(in.camera.width, in.camera.height, names);
   const GridShape& g = in.density->shape;
   VoxelLightWorkspace local;
@@ -80,12 +96,14 @@ Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds) {
   dispatch_method(m.settings.method, [&](auto method) {
     tbb::parallel_for(tbb::blocked_range<int>(0, in.camera.height), [&](const auto& rows) {
       DynamicAccumulators acc;  // run-time extents: registers matter on the GPU, not here
+      float em[kMaxEmissionPlanes];
       for (int y = rows.begin(); y != rows.end(); ++y)
         for (int x = 0; x < in.camera.width; ++x) {
           Vec3 origin, dir;
           if (!in.camera.ray(x, y, origin, dir)) continue;
-          march_spectral<method()>(view, origin, dir, acc);
+          march_spectral<method()>(view, origin, dir, acc, em);
           store_accumulators(view, acc, &image.at(0, x, y), image.plane_size());
+          store_emission(view, em, &image.at(0, x, y), image.plane_size());
         }
     });
   });
@@ -96,12 +114,15 @@ Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds) {
 Image resolve_filters(const Image& acc, const SpectralModel& m, float exposure) {
   Image out(acc.width, acc.height, m.filter_names);
   const size_t plane = acc.plane_size();
-  const int F = int(m.filter_names.size());
+  const int F = int(m.filter_names.size()), W = m.planes();
+  if (acc.bands.size() != size_t(W))
+    throw Error("spectral resolve: the image has " + std::to_string(acc.bands.size()) + " planes; the model " +
+                std::to_string(W));
   tbb::parallel_for(size_t(0), plane, size_t(4096), [&](size_t p0) {
     for (size_t p = p0; p < std::min(plane, p0 + 4096); ++p)
       for (int f = 0; f < F; ++f) {
         double v = 0.0;
-        for (int k = 0; k < m.n_acc; ++k) v += double(m.resolve[size_t(f) * m.n_acc + k]) * acc.pixels[k * plane + p];
+        for (int k = 0; k < W; ++k) v += double(m.resolve[size_t(f) * W + k]) * acc.pixels[k * plane + p];
         out.pixels[f * plane + p] = exposure * float(v);
       }
   });

@@ -28,6 +28,13 @@ struct VoxelLightWorkspace {
   std::vector<unsigned> near;
 };
 
+// An emission component's weight per voxel (SpectralEmission: j = w phi): the
+// grid (the density's shape) times scale, or the voxel's tau_V times scale.
+struct SpectralEmissionWeight {
+  const std::vector<float>* grid = nullptr;
+  float scale = 1;
+};
+
 struct SpectralRenderInputs {
   const DensityGrid* density = nullptr;
   const SpectralModel* model = nullptr;  // built for these lights, in this order
@@ -37,11 +44,12 @@ struct SpectralRenderInputs {
   // table_nodes attenuations (docs/spectral.md, "Tables"); null, or a model
   // with table_nodes 0: the thin-voxel limit P = tau_sct p_HG.
   const ScatteringTable* table = nullptr;
+  std::vector<SpectralEmissionWeight> emission;  // one per model->emission component
   Camera camera;
   VoxelLightWorkspace* workspace = nullptr;  // VoxelLight on the CPU: reused buffers (optional)
 };
 
-// The accumulator image (model->n_acc planes); `seconds` the march alone
+// The accumulator image (model->planes(): the stars', then the emission's); `seconds` the march alone
 // (CUDA events on the GPU). Throws Error on inconsistent inputs (a table for
 // another albedo or g than the dust's among them).
 Image render_spectral(const SpectralRenderInputs& in, Backend backend, double* seconds = nullptr);
@@ -50,6 +58,10 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds);
 
 // One plane per filter (the model's names), times the exposure.
 Image resolve_filters(const Image& accumulators, const SpectralModel& model, float exposure = 1.0f);
+
+// The scene view's emission weights (`grids[c]`: component c's grid where it
+// lives, host or device, or null for tau_V).
+void set_emission(SpectralSceneView& view, const SpectralRenderInputs& in, const std::vector<const float*>& grids);
 
 // The scene view's table fields for these inputs (both backends; `P` is the
 // table's values where they live, host or device).

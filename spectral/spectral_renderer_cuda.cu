@@ -23,8 +23,11 @@ __global__ void spectral_kernel(SpectralSceneView scene, Camera camera, float* p
   Vec3 origin, dir;
   if (!camera.ray(x, y, origin, dir)) return;
   Acc acc;
-  march_spectral<kMethod>(scene, origin, dir, acc);
-  store_accumulators(scene, acc, pixels + size_t(y) * camera.width + x, size_t(camera.width) * camera.height);
+  float em[kMaxEmissionPlanes];  // local memory, touched only with emission
+  march_spectral<kMethod>(scene, origin, dir, acc, em);
+  const size_t stride = size_t(camera.width) * camera.height;
+  store_accumulators(scene, acc, pixels + size_t(y) * camera.width + x, stride);
+  store_emission(scene, em, pixels + size_t(y) * camera.width + x, stride);
 }
 
 // VoxelLight's per-view pre-pass: one voxel per thread (spectral_march.h);
@@ -118,6 +121,13 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
   view.breaks = upload(doubles, m.breaks);
   view.coefficients = upload(doubles, m.coefficients);
   view.star_coeff = upload(floats, m.star_coeff);
+  view.emission_q = upload(floats, m.emission_q);
+  view.emission_breaks = upload(doubles, m.emission_breaks);
+  view.emission_coefficients = upload(doubles, m.emission_coefficients);
+  view.emission_coeff = m.emission_coeff.empty() ? view.coeff : upload(floats, m.emission_coeff);
+  std::vector<const float*> grids;
+  for (const SpectralEmissionWeight& e : in.emission) grids.push_back(e.grid ? upload(floats, *e.grid) : nullptr);
+  set_emission(view, in, grids);
   const bool voxel = m.settings.method == SpectralMethod::VoxelLight;
   const size_t cells = in.density->shape.count();
   DeviceArray<float> light(voxel ? cells * 4 * size_t(m.n_acc) * m.basis.size() : 0);
@@ -128,7 +138,7 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
     view.near_stars = near.get();
   }
   std::vector<std::string> names;
-  for (int k = 0; k < m.n_acc; ++k) names.push_back("acc" + std::to_string(k));
+  for (int k = 0; k < m.planes(); ++k) names.push_back("acc" + std::to_string(k));
   Image image(in.camera.width, in.camera.height, names);
   DeviceArray<float> pixels(image.pixels.size());
   const dim3 block(16, 16), grid((in.camera.width + 15) / 16, (in.camera.height + 15) / 16);
