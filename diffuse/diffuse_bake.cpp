@@ -232,6 +232,7 @@ std::vector<DiffuseField> bake_diffuse_shared(const DensityGrid& density,
     if (n_sets > 1)
       for (const std::vector<DiffuseBand>& set : sets) in.slot_albedos.push_back(set[b].albedo);
     in.band_index = static_cast<uint32_t>(b);
+    in.stream = o.common_streams ? 0u : in.band_index;
     in.cells = cells;
     in.degree = o.degree;
     in.zonal = o.zonal;

@@ -43,6 +43,12 @@ struct DiffuseBakeOptions {
   // "diffuse_zonal": degrees degree + 1 .. this of each of the brightest
   // kMaxZonalStars stars' light, about the direction from the star (0: none).
   int zonal = 0;
+  // Every band's photons draw the same random numbers (band 0's streams), so
+  // that the fields of bands that differ a little (the spectral renderer's
+  // attenuations) differ by their physics more than by their noise: the same
+  // photon takes the same decisions until an attenuation changes one. Off:
+  // each band its own streams (independent noise per band).
+  bool common_streams = false;
 };
 
 struct DiffuseBakeStats {
@@ -84,6 +90,7 @@ struct DiffusePassInputs {
   std::vector<float> star_cdf;
   Band band;
   uint32_t band_index = 0;
+  uint32_t stream = 0;  // the photons' random streams: band_index, or 0 (DiffuseBakeOptions::common_streams)
   GridShape cells;
   int degree = 0;
   int zonal = 0, zonal_stars = 0;  // DiffuseField's: the stars' first zonal_stars have zonal blocks
@@ -168,7 +175,7 @@ DiffusePhotonScene assemble_photon_scene(const DiffusePassInputs& in, Place& pla
   s.star_cdf = place.place(in.star_cdf);
   s.n_stars = static_cast<int>(in.stars.size());
   s.seed = in.seed;
-  s.band = in.band_index;
+  s.band = in.stream;
   s.roulette_start = in.roulette_start;
   s.max_orders = in.max_orders;
   const DiffuseSlots layout = diffuse_slots(in, in.cells.count(), s.n_coeffs);

@@ -59,7 +59,7 @@ struct DiffusePhotonScene {
   const float* star_cdf = nullptr; // cumulative band power fractions, last = 1
   int n_stars = 0;
   uint64_t seed = 1;
-  uint32_t band = 0;
+  uint32_t band = 0;  // the photons' random streams (DiffusePassInputs::stream)
   int roulette_start = 3;
   int max_orders = 0;   // 0: every order; k > 0: flights after collisions 1..k only (tests, studies)
   // Albedos deposited for (DiffuseSlots): slot k's scale a_k / albedo <= 1.

@@ -46,6 +46,50 @@ void validate(const RenderInputs& in) {
   }
 }
 
+namespace {
+
+// The field's per-view pass on the CPU into light[b], peak[b] (sized here, per
+// band with a field), which the scene then reads.
+void diffuse_light_pass_cpu(MarchScene& scene, const Camera& camera, std::vector<std::vector<float>>& light,
+                            std::vector<std::vector<float>>& peak) {
+  const GridShape& g = scene.density.shape;
+  DiffuseLightPlanes planes;
+  for (int b = 0; b < scene.n_bands; ++b)
+    if (scene.diffuse.has[b]) {
+      light[b].assign(g.count(), 0.0f);
+      peak[b].assign(g.count(), 0.0f);
+      planes.band[b] = light[b].data();
+      planes.peak[b] = peak[b].data();
+      scene.diffuse_light[b] = planes.band[b];
+      scene.diffuse_peak[b] = planes.peak[b];
+    }
+  dispatch_diffuse_degree(scene.diffuse.degree, [&](auto degree) {
+    dispatch_zonal(scene, [&](auto zonal) {
+      tbb::parallel_for(tbb::blocked_range<int>(0, g.ny * g.nz), [&](const auto& rows) {
+        for (int r = rows.begin(); r != rows.end(); ++r)
+          diffuse_light_row<degree(), zonal()>(scene, camera, r % g.ny, r / g.ny, 0, g.nx, planes);
+      });
+    });
+  });
+}
+
+}  // namespace
+
+DiffuseLightArrays diffuse_light_arrays(const RenderInputs& in, Backend backend) {
+  validate(in);
+  if (!in.diffuse) throw Error("diffuse light: no diffuse field");
+  if (backend == Backend::Cuda) return diffuse_light_arrays_cuda(in);
+  HostPlacement host;
+  MarchScene scene = assemble_march_scene(in, host);
+  DiffuseLightArrays out;
+  out.light.resize(kMaxBands);
+  out.peak.resize(kMaxBands);
+  diffuse_light_pass_cpu(scene, in.camera, out.light, out.peak);
+  out.light.resize(in.bands.size());
+  out.peak.resize(in.bands.size());
+  return out;
+}
+
 Image render_cpu(const RenderInputs& in, RenderStats* stats) {
   HostPlacement host;
   MarchScene scene = assemble_march_scene(in, host);
@@ -78,25 +122,7 @@ Image render_cpu(const RenderInputs& in, RenderStats* stats) {
       });
     });
   } else if (scene.has_diffuse) {
-    const GridShape& g = scene.density.shape;
-    DiffuseLightPlanes planes;
-    for (int b = 0; b < scene.n_bands; ++b)
-      if (scene.diffuse.has[b]) {
-        light[b].assign(g.count(), 0.0f);
-        peak[b].assign(g.count(), 0.0f);
-        planes.band[b] = light[b].data();
-        planes.peak[b] = peak[b].data();
-        scene.diffuse_light[b] = planes.band[b];
-        scene.diffuse_peak[b] = planes.peak[b];
-      }
-    dispatch_diffuse_degree(scene.diffuse.degree, [&](auto degree) {
-      dispatch_zonal(scene, [&](auto zonal) {
-        tbb::parallel_for(tbb::blocked_range<int>(0, g.ny * g.nz), [&](const auto& rows) {
-          for (int r = rows.begin(); r != rows.end(); ++r)
-            diffuse_light_row<degree(), zonal()>(scene, in.camera, r % g.ny, r / g.ny, 0, g.nx, planes);
-        });
-      });
-    });
+    diffuse_light_pass_cpu(scene, in.camera, light, peak);
   }
   dispatch_march(scene, in.mode, [&](auto smooth, auto diffuse, auto voxel_sources, auto zonal) {
     constexpr bool exact = !smooth() && !voxel_sources();

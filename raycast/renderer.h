@@ -59,4 +59,15 @@ double render_cuda_to_device(const RenderInputs& in, float* device_pixels, unsig
 // Host-side checks shared by both backends.
 void validate(const RenderInputs& in);
 
+// The diffuse field's per-view pass alone (raycast/diffuse_light.h), for
+// renderers that march on their own (spectral/, through the pipeline): each
+// voxel's light towards in.camera's eye and its forward peak, per band with a
+// field ([band][voxel], host memory; empty for a band without one). The same
+// numbers the march of render() reads. Throws Error without a field.
+struct DiffuseLightArrays {
+  std::vector<std::vector<float>> light, peak;
+};
+DiffuseLightArrays diffuse_light_arrays(const RenderInputs& in, Backend backend);
+DiffuseLightArrays diffuse_light_arrays_cuda(const RenderInputs& in);
+
 }  // namespace nebula

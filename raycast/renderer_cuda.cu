@@ -234,6 +234,39 @@ double render_cuda_to_device(const RenderInputs& in, float* pixels, unsigned lon
   return timer.seconds();
 }
 
+DiffuseLightArrays diffuse_light_arrays_cuda(const RenderInputs& in) {
+  DevicePlacement device;
+  MarchScene scene = assemble_march_scene(in, device);
+  const size_t count = scene.density.shape.count();
+  DiffuseLightPlanes planes;
+  std::vector<std::unique_ptr<DeviceArray<float>>> keep;
+  for (int b = 0; b < scene.n_bands; ++b)
+    if (scene.diffuse.has[b]) {
+      keep.push_back(std::make_unique<DeviceArray<float>>(count));
+      planes.band[b] = keep.back()->get();
+      keep.push_back(std::make_unique<DeviceArray<float>>(count));
+      planes.peak[b] = keep.back()->get();
+    }
+  const unsigned voxel_blocks = static_cast<unsigned>((count + 255) / 256);
+  dispatch_diffuse_degree(scene.diffuse.degree, [&](auto degree) {
+    dispatch_zonal(scene, [&](auto zonal) {
+      diffuse_light_kernel<degree(), zonal()><<<voxel_blocks, 256>>>(scene, in.camera, planes);
+    });
+  });
+  NEBULA_CUDA_CHECK(cudaGetLastError());
+  DiffuseLightArrays out;
+  out.light.resize(in.bands.size());
+  out.peak.resize(in.bands.size());
+  for (int b = 0; b < scene.n_bands; ++b)
+    if (planes.band[b]) {
+      out.light[b].resize(count);
+      out.peak[b].resize(count);
+      NEBULA_CUDA_CHECK(cudaMemcpy(out.light[b].data(), planes.band[b], count * sizeof(float), cudaMemcpyDeviceToHost));
+      NEBULA_CUDA_CHECK(cudaMemcpy(out.peak[b].data(), planes.peak[b], count * sizeof(float), cudaMemcpyDeviceToHost));
+    }
+  return out;
+}
+
 Image render_cuda(const RenderInputs& in, RenderStats* stats) {
   // Every pixel is downloaded below: the memory of a recycled frame will do.
   Image image = take_frame_image(in.camera.width, in.camera.height, band_names(in.bands));
