@@ -65,6 +65,11 @@ class DeviceMirror {
     device_ = same.device_;
     bytes_ = same.bytes_;
   }
+  // The device copy it holds (none: a null device pointer).
+  Copy current() const {
+    std::lock_guard<std::mutex> lock(mutex());
+    return {owner_, device_};
+  }
   bool holds(size_t bytes) const {
     std::lock_guard<std::mutex> lock(mutex());
     return device_ != nullptr && bytes_ == bytes;

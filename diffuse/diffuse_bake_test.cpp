@@ -186,6 +186,28 @@ TEST(DiffuseBake, TheSameFieldOnOneThreadOrMany) {
   EXPECT_EQ(atomic.host_packed(), many.host_packed());
 }
 
+// Common streams (the spectral renderer's nodes): two bands alike but for
+// their names take the same photons, so their fields are equal bit for bit;
+// each on its own streams (the default) they are two draws of the same field.
+TEST(DiffuseBake, CommonStreamsGiveBandsAlikeOneField) {
+  const DensityGrid grid = cube(8, 0.3f);
+  const ScatteringTable table = thin_table(0.6);
+  DiffuseBand a = v_band(0.8f, 0.6f, table), b = a;
+  b.name = "W";
+  DiffuseBakeOptions o;
+  o.photons = 20000;
+  const std::vector<StarLight> stars{{{0.1f, -0.2f, 0.3f}, {1.0f, 1.0f}}};
+  const auto bands_equal = [](const DiffuseField& f) {
+    const std::vector<float>& p = f.host_packed();  // [(cell * coeffs + k) * 4 + band]
+    bool equal = true;
+    for (size_t i = 0; i + 1 < p.size(); i += 4) equal = equal && p[i] == p[i + 1];
+    return equal;
+  };
+  EXPECT_FALSE(bands_equal(bake_diffuse(grid, {a, b}, stars, o, Backend::Cpu)));
+  o.common_streams = true;
+  EXPECT_TRUE(bands_equal(bake_diffuse(grid, {a, b}, stars, o, Backend::Cpu)));
+}
+
 // Zonal degrees add to the harmonics without changing them (the same photons,
 // the same sums), and they are what they say: the degrees beyond the
 // harmonics of the light about the direction from the star. Around a star in

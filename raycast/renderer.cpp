@@ -87,6 +87,8 @@ DiffuseLightArrays diffuse_light_arrays(const RenderInputs& in, Backend backend)
   diffuse_light_pass_cpu(scene, in.camera, out.light, out.peak);
   out.light.resize(in.bands.size());
   out.peak.resize(in.bands.size());
+  out.device_light.resize(in.bands.size());
+  out.device_peak.resize(in.bands.size());
   return out;
 }
 

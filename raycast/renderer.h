@@ -62,10 +62,13 @@ void validate(const RenderInputs& in);
 // The diffuse field's per-view pass alone (raycast/diffuse_light.h), for
 // renderers that march on their own (spectral/, through the pipeline): each
 // voxel's light towards in.camera's eye and its forward peak, per band with a
-// field ([band][voxel], host memory; empty for a band without one). The same
-// numbers the march of render() reads. Throws Error without a field.
+// field ([band][voxel]; empty for a band without one). The same numbers the
+// march of render() reads. On the CPU they are host arrays; from CUDA they
+// stay on the device (device_light, device_peak: one array of the grid's
+// voxels per band with a field), the host arrays empty. Throws Error without a field.
 struct DiffuseLightArrays {
   std::vector<std::vector<float>> light, peak;
+  std::vector<DeviceMirror> device_light, device_peak;
 };
 DiffuseLightArrays diffuse_light_arrays(const RenderInputs& in, Backend backend);
 DiffuseLightArrays diffuse_light_arrays_cuda(const RenderInputs& in);

@@ -239,13 +239,21 @@ DiffuseLightArrays diffuse_light_arrays_cuda(const RenderInputs& in) {
   MarchScene scene = assemble_march_scene(in, device);
   const size_t count = scene.density.shape.count();
   DiffuseLightPlanes planes;
-  std::vector<std::unique_ptr<DeviceArray<float>>> keep;
+  DiffuseLightArrays out;
+  out.light.resize(in.bands.size());
+  out.peak.resize(in.bands.size());
+  out.device_light.resize(in.bands.size());
+  out.device_peak.resize(in.bands.size());
+  // Device arrays the result's mirrors own (its host arrays stay empty).
+  const auto made = [&](DeviceMirror& mirror) {
+    auto array = std::make_shared<DeviceArray<float>>(count);
+    mirror.set({array, array->get()}, array->bytes());
+    return array->get();
+  };
   for (int b = 0; b < scene.n_bands; ++b)
     if (scene.diffuse.has[b]) {
-      keep.push_back(std::make_unique<DeviceArray<float>>(count));
-      planes.band[b] = keep.back()->get();
-      keep.push_back(std::make_unique<DeviceArray<float>>(count));
-      planes.peak[b] = keep.back()->get();
+      planes.band[b] = made(out.device_light[size_t(b)]);
+      planes.peak[b] = made(out.device_peak[size_t(b)]);
     }
   const unsigned voxel_blocks = static_cast<unsigned>((count + 255) / 256);
   dispatch_diffuse_degree(scene.diffuse.degree, [&](auto degree) {
@@ -254,16 +262,6 @@ DiffuseLightArrays diffuse_light_arrays_cuda(const RenderInputs& in) {
     });
   });
   NEBULA_CUDA_CHECK(cudaGetLastError());
-  DiffuseLightArrays out;
-  out.light.resize(in.bands.size());
-  out.peak.resize(in.bands.size());
-  for (int b = 0; b < scene.n_bands; ++b)
-    if (planes.band[b]) {
-      out.light[b].resize(count);
-      out.peak[b].resize(count);
-      NEBULA_CUDA_CHECK(cudaMemcpy(out.light[b].data(), planes.band[b], count * sizeof(float), cudaMemcpyDeviceToHost));
-      NEBULA_CUDA_CHECK(cudaMemcpy(out.peak[b].data(), planes.peak[b], count * sizeof(float), cudaMemcpyDeviceToHost));
-    }
   return out;
 }
 
