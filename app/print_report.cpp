@@ -52,8 +52,10 @@ void print_multiple_scattering(const RunReport& r) {
                   d.shared_with);
   }
   if (d.done) {
-    for (size_t b = 0; b < d.noise.size() && b < r.bands.size(); ++b)
-      if (d.noise[b] >= 0) std::printf(" %s %.2g%%", r.bands[b].name.c_str(), 100 * d.noise[b]);
+    const size_t named = d.names.empty() ? r.bands.size() : d.names.size();
+    for (size_t b = 0; b < d.noise.size() && b < named; ++b)
+      if (d.noise[b] >= 0)
+        std::printf(" %s %.2g%%", (d.names.empty() ? r.bands[b].name : d.names[b]).c_str(), 100 * d.noise[b]);
     std::printf("; memory %.3g MiB kept, %.3g MiB while baking%s\n", d.field_bytes / 1048576.0,
                 d.work_bytes / 1048576.0, d.capped ? " (some photons stopped at the order cap)" : "");
   } else if (r.multiple_scattering == "diffuse") {
@@ -104,7 +106,13 @@ void print_spectral(const RunReport& r) {
   if (s.table_nodes > 0) {
     std::printf("  scattering per voxel through its table (multiple scattering inside it), read at kappa =");
     for (double k : s.node_kappa) std::printf(" %.3g", k);
-    std::printf(" and interpolated in kappa between; no light between voxels\n");
+    std::printf(" and interpolated in kappa between\n");
+    if (r.diffuse.done)
+      std::printf("  light between voxels: the band renderer's diffuse field of each star alone (%zu field(s)), baked "
+                  "at those attenuations (one band each, the star's light at its wavelength), per-view passes %.3g s; "
+                  "below, times and photon counts of all of them, noise and memory of the first\n",
+                  r.diffuse.stars, s.diffuse_view_seconds);
+    print_multiple_scattering(r);
   } else {
     std::printf("  single scattering per voxel (thin-voxel HG, spectral.tables = false); no light between voxels\n");
   }

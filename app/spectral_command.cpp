@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <list>
 #include <optional>
 #include <thread>
 
@@ -20,6 +21,7 @@
 #include "illumination/optical_depth_bake.h"
 #include "pipeline/run_setup.h"
 #include "pipeline/scene_bands.h"
+#include "pipeline/spectral_scene.h"
 #include "scene/scene_file.h"
 #include "spectral/piecewise_polynomial.h"
 #include "spectral/spectral_renderer.h"
@@ -133,7 +135,7 @@ void add_spectral_bench(CLI::App* bench) {
     int size = 64, width = 256, height = 256, repeats = 3, stars = 1, reference = 400;
     double near_voxels = spectral::SpectralSettings{}.near_voxels;
     float tau = 4.0f;
-    bool quick = false;
+    bool quick = false, diffuse = false;
     std::vector<std::string> filters{"B", "V", "R"};
   };
   auto o = std::make_shared<Options>();
@@ -165,11 +167,16 @@ void add_spectral_bench(CLI::App* bench) {
   cmd->add_option("--table-nodes", o->table_nodes, "with --table: attenuations the table is read at")
       ->capture_default_str()
       ->check(CLI::Range(1, spectral::kMaxTableNodes));
+  cmd->add_flag("--diffuse", o->diffuse,
+                "with --scene and --table: every row with the light between voxels (the scene's render.diffuse_* "
+                "settings), its field baked once and its per-view pass timed apart (docs/spectral.md)");
   cmd->add_option("--json", o->json, "also write the results as JSON to this file");
   cmd->callback([o, width, height] {
     if (o->attenuation != "inverse" && o->attenuation != "law")
       throw Error("--attenuation: '" + o->attenuation + "' is not inverse or law");
     if (!o->json.empty()) check_output_target(o->json, true, "folder", true);
+    if (o->diffuse && (o->scene.empty() || o->table.empty()))
+      throw Error("--diffuse: needs --scene (the field's settings and stars) and --table (the voxels' response)");
     std::vector<Backend> backends;
     std::string why;
     const bool gpu = gpu_available(&why);
@@ -178,8 +185,10 @@ void add_spectral_bench(CLI::App* bench) {
     if (!gpu && o->backends != "cpu" && o->backends != "auto") throw Error("--backend: no CUDA device (" + why + ")");
 
     BenchScene b;
+    std::optional<Scene> loaded;
     if (!o->scene.empty()) {
-      const Scene scene = load_scene(o->scene, o->overrides);
+      loaded = load_scene(o->scene, o->overrides);
+      const Scene& scene = *loaded;
       if (scene.axial) throw Error(o->scene + ": the spectral bench renders 3D grids");
       b.name = o->scene;
       b.grid = scene.density;
@@ -234,10 +243,34 @@ void add_spectral_bench(CLI::App* bench) {
         throw Error("--table: " + o->table + " holds albedo " + to_text(table->albedo) + ", g " + to_text(table->g) +
                     "; the dust has albedo " + to_text(b.albedo) + ", g " + to_text(b.g));
     }
-    const BakeResult bake = bake_star_depths(b.grid, b.positions, gpu ? Backend::Cuda : Backend::Cpu);
+    BakeResult bake = bake_star_depths(b.grid, b.positions, gpu ? Backend::Cuda : Backend::Cpu);
     std::vector<spectral::SpectralStar> stars;
     for (double t : b.temperature) stars.push_back({t});
     const int S = int(stars.size());
+    // --diffuse: the light between voxels for a model's table nodes (the same for every row
+    // that reads the table at as many nodes), baked and projected for the camera once.
+    std::list<std::pair<std::vector<double>, spectral::SpectralDiffuseLight>> lights;  // stable addresses
+    const auto diffuse_light = [&](const spectral::SpectralModel& m) -> const spectral::SpectralDiffuseLight* {
+      if (!o->diffuse || m.node_kappa.empty()) return nullptr;
+      for (const auto& [nodes, light] : lights)
+        if (nodes == m.node_kappa) return &light;
+      RunReport report;
+      RenderOptions options;
+      options.backend = gpu ? Backend::Cuda : Backend::Cpu;
+      double view = 0;
+      const auto start = std::chrono::steady_clock::now();
+      spectral::SpectralDiffuseLight light =
+          spectral_diffuse_light(*loaded, m, *table, bake, b.camera, options, report, &view);
+      std::printf("light between voxels at kappa =");
+      for (double k : m.node_kappa) std::printf(" %.3g", k);
+      std::printf(": %zu star(s) x %zu photons per node, fields %.3f s (photon passes %.3f s), per-view passes %.4f s "
+                  "(%s; once per view, not in the rows' times, which hold the voxels' terms)\n",
+                  report.diffuse.stars, size_t(report.diffuse.photons_per_band),
+                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - view,
+                  report.diffuse.seconds, view, to_string(options.backend));
+      lights.push_back({m.node_kappa, std::move(light)});
+      return &lights.back().second;
+    };
     // The first `stars` stars (all by default); the voxel-light buffers reused between frames.
     const auto inputs = [&](const spectral::SpectralModel& m, spectral::VoxelLightWorkspace* work = nullptr) {
       spectral::SpectralRenderInputs in;
@@ -249,6 +282,7 @@ void add_spectral_bench(CLI::App* bench) {
       in.g = b.g;
       in.camera = b.camera;
       in.table = table ? &*table : nullptr;
+      if (m.n_stars == S) in.diffuse = diffuse_light(m);
       for (size_t c = 0; c < b.emission.size(); ++c) {  // a grid (scale applied) or tau_V times the scale
         const bool grid = !b.emission_grids[c].empty();
         in.emission.push_back({grid ? &b.emission_grids[c] : nullptr, grid ? 1.0f : b.emission_scale[c]});

@@ -62,6 +62,8 @@ struct DiffuseReport {
   double seconds = 0;          // the photon passes (CUDA events on the GPU)
   double wall_seconds = 0;     // the whole bake, responses included
   std::vector<double> noise;   // per scene band: relative L2 noise of the field's l = 0 part; -1: no field
+  std::vector<std::string> names;  // the baked bands' names where they are not the scene's (spectral: the nodes)
+  size_t stars = 0;  // fields baked star by star (spectral; 0: all stars in one)
   uint64_t collisions = 0, crossings = 0, capped = 0;
   size_t field_bytes = 0, work_bytes = 0;
 };
@@ -113,6 +115,7 @@ struct SpectralReport {
   std::vector<double> node_kappa; // their kappa = tau / tau_V
   double model_seconds = 0;       // fits, basis and tables (host)
   double resolve_seconds = 0;     // accumulators to one plane per filter
+  double diffuse_view_seconds = 0;  // light between voxels: the field's per-view pass and the voxels' terms
 };
 
 struct RunReport {

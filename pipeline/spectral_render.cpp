@@ -3,14 +3,17 @@
 // function of wavelength; one V-band depth bake per star; the spectral march
 // (spectral/) and the resolve into one plane per filter.
 #include <chrono>
+#include <cstdio>
 #include <string>
 
 #include "core/error.h"
+#include "core/progress.h"
 #include "illumination/optical_depth_bake.h"
 #include "pipeline/render_scene.h"
 #include "pipeline/run_setup.h"
 #include "pipeline/spectral_scene.h"
 #include "pipeline/table_source.h"
+#include "raycast/renderer.h"
 #include "spectral/spectral_renderer.h"
 
 namespace nebula {
@@ -28,6 +31,81 @@ spectral::SpectralMethod method_of(const std::string& name) {
 }
 
 }  // namespace
+
+// One band per table node: its attenuation kappa_m, the dust's albedo, g and
+// table, the star's power L s(lambda_m) at a wavelength where kappa(lambda_m) =
+// kappa_m (spectral_scene.h).
+spectral::SpectralDiffuseLight spectral_diffuse_light(const Scene& scene, const spectral::SpectralModel& model,
+                                                      const ScatteringTable& table, BakeResult& bake,
+                                                      const Camera& camera, const RenderOptions& o,
+                                                      RunReport& report, double* view_seconds) {
+  const int n = int(model.node_kappa.size());
+  std::vector<DiffuseBand> bands(static_cast<size_t>(n));
+  std::vector<RenderBand> render_bands(static_cast<size_t>(n));
+  std::vector<double> lambda(static_cast<size_t>(n));
+  for (int m = 0; m < n; ++m) {
+    DiffuseBand& b = bands[size_t(m)];
+    char name[32];
+    std::snprintf(name, sizeof name, "kappa %.3g", model.node_kappa[size_t(m)]);
+    b.name = name;
+    b.extinction_ratio = float(model.node_kappa[size_t(m)]);
+    b.albedo = float(scene.dust.albedo.front());
+    b.g = float(scene.dust.g.front());
+    b.table = &table;
+    static_cast<Band&>(render_bands[size_t(m)]) = b;
+    render_bands[size_t(m)].table = &table;
+    lambda[size_t(m)] = model.wavelength_of_kappa(model.node_kappa[size_t(m)]);
+  }
+  DiffuseBakeOptions options = diffuse_options(scene);
+  options.common_streams = true;  // the nodes' fields differ by their attenuation more than by their noise
+  spectral::SpectralDiffuseLight out;
+  *view_seconds = 0;
+  for (size_t k = 0; k < scene.stars.size(); ++k) {
+    const auto t0 = std::chrono::steady_clock::now();
+    BakedStar star;
+    star.position = scene.stars[k].position;
+    star.depth_v = &bake.tau_v[k];
+    if (k < bake.device_tau_v.size()) star.depth_mirror = &bake.device_tau_v[k];  // uploaded once, not per pass
+    std::vector<double> power;
+    for (int m = 0; m < n; ++m)  // L_sun um^-1
+      power.push_back(scene.stars[k].luminosity_lsun * model.stars[k].shape(lambda[size_t(m)]));
+    for (double p : power) star.power.push_back(float(p));
+    out.node_power.push_back(power);
+    DiffuseBakeStats stats;
+    std::unique_ptr<Progress> bar = diffuse_progress(bands, options, o);
+    const DiffuseField field = bake_diffuse(scene.density, bands, {star}, options, o.backend, &stats, bar.get());
+    bar.reset();
+    const DiffuseReport r = diffuse_report(bands, options, field, 1 << field.shift, stats, seconds_since(t0));
+    if (k == 0) {
+      report.diffuse = r;
+      for (const DiffuseBand& b : bands) report.diffuse.names.push_back(b.name);
+    } else {  // the stars' bakes together; noise and memory: the first star's (each star's field is baked alone)
+      report.diffuse.seconds += r.seconds;
+      report.diffuse.wall_seconds += r.wall_seconds;
+      report.diffuse.collisions += r.collisions;
+      report.diffuse.crossings += r.crossings;
+      report.diffuse.capped += r.capped;
+    }
+    const auto t_view = std::chrono::steady_clock::now();
+    RenderInputs view;
+    view.density = &scene.density;
+    view.bands = render_bands;
+    view.stars = {star};
+    view.diffuse = &field;
+    view.camera = camera;
+    DiffuseLightArrays arrays = diffuse_light_arrays(view, o.backend);
+    if (o.backend == Backend::Cuda) {  // left on the device, where the CUDA renderer reads them
+      out.device_light.push_back(std::move(arrays.device_light));
+      if (k == 0) out.device_peak = std::move(arrays.device_peak);
+    } else {
+      out.light.push_back(std::move(arrays.light));
+      if (k == 0) out.peak = std::move(arrays.peak);
+    }
+    *view_seconds += seconds_since(t_view);
+  }
+  report.diffuse.stars = scene.stars.size();
+  return out;
+}
 
 spectral::SpectralSettings spectral_settings(const Scene& scene) {
   if (!scene.spectral) throw Error(scene.path + ": spectral: the scene has no [spectral] table");
@@ -78,6 +156,12 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
   std::vector<spectral::SpectralStar> stars;
   for (const SceneStar& s : scene.stars) stars.push_back({s.temperature_K});
   const spectral::SpectralSettings settings = spectral_settings(scene);
+  if (scene.multiple_scattering == MultipleScattering::Pyramid)
+    throw Error(scene.path + ": render.multiple_scattering: the spectral renderer takes the light between voxels "
+                             "from the diffuse field (\"diffuse\", the default) or none (\"none\"); no pyramid");
+  // Light between voxels: the band renderer's diffuse field baked at the nodes (needs the tables and a star).
+  const bool diffuse = scene.multiple_scattering == MultipleScattering::Diffuse && table && settings.table_nodes >= 1 &&
+                       !scene.stars.empty();
   std::vector<spectral::SpectralEmission> emission;
   for (const SpectralEmissionSpec& e : scene.spectral->emission)
     emission.push_back({e.line_nm / 1000.0, e.continuum, e.lo_nm / 1000.0, e.hi_nm / 1000.0});
@@ -133,6 +217,11 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
     in.emission.push_back({grid, grid ? 1.0f : float(scene.spectral->emission[c].scale)});
   }
   in.camera = make_camera(scene.camera);
+  spectral::SpectralDiffuseLight diffuse_light;
+  if (diffuse) {
+    diffuse_light = spectral_diffuse_light(scene, model, *table, bake, in.camera, o, report, &sr.diffuse_view_seconds);
+    in.diffuse = &diffuse_light;
+  }
   double march_seconds = 0;
   const Image acc = spectral::render_spectral(in, o.backend, &march_seconds);
   const auto t_resolve = std::chrono::steady_clock::now();
@@ -145,9 +234,14 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
 
   out.report = report;
   out.metadata = scene_metadata(scene, bands, scene.camera, report.mode);
+  report.multiple_scattering = diffuse ? "diffuse" : "none";
+  out.report.multiple_scattering = report.multiple_scattering;
   out.metadata.entries.push_back(
-      {"multiple_scattering", table ? "inside voxels (tables), none between them (spectral renderer)"
-                                    : "none (spectral renderer: thin-voxel single scattering)"});
+      {"multiple_scattering",
+       diffuse ? "inside voxels (tables) and between them (the diffuse field at " + std::to_string(settings.table_nodes) +
+                     " attenuations; spectral renderer)"
+       : table ? "inside voxels (tables), none between them (spectral renderer)"
+               : "none (spectral renderer: thin-voxel single scattering)"});
   out.metadata.entries.push_back({"spec_nodes", sr.table_nodes});
   out.metadata.entries.push_back({"spec_emission", int(emission.size())});
   out.metadata.entries.push_back({"spec_method", sr.method});

@@ -75,19 +75,24 @@ std::vector<double> project(const WavelengthGrid& grid, const GreedyBasis& basis
 
 std::vector<double> project_relative(const WavelengthGrid& grid, const GreedyBasis& basis,
                                      const std::vector<double>& f) {
+  return project_relative(grid, basis, f, f);
+}
+
+std::vector<double> project_relative(const WavelengthGrid& grid, const GreedyBasis& basis, const std::vector<double>& f,
+                                     const std::vector<double>& envelope) {
   const size_t G = f.size(), N = basis.phi.size();
   double peak = 0.0;
-  for (double v : f) peak = std::max(peak, std::fabs(v));
+  for (double v : envelope) peak = std::max(peak, std::fabs(v));
   if (!(peak > 0.0)) return std::vector<double>(N, 0.0);
-  // Rows sqrt(w_i) phi_j(i) / f_i, right-hand side sqrt(w_i): the residual of row i
-  // is sqrt(w_i) (f_i - sum c_j phi_j(i)) / f_i.
+  // Rows sqrt(w_i) phi_j(i) / e_i, right-hand side sqrt(w_i) f_i / e_i: the residual of row i
+  // is sqrt(w_i) (f_i - sum c_j phi_j(i)) / e_i.
   std::vector<std::vector<double>> a(N, std::vector<double>(G));  // columns
   std::vector<double> b(G);
   for (size_t i = 0; i < G; ++i) {
-    const double fi = std::max(std::fabs(f[i]), 1e-200 * peak);
-    const double s = std::sqrt(grid.weight[i]) / fi;
+    const double ei = std::max(std::fabs(envelope[i]), 1e-200 * peak);
+    const double s = std::sqrt(grid.weight[i]) / ei;
     for (size_t j = 0; j < N; ++j) a[j][i] = basis.phi[j][i] * s;
-    b[i] = std::sqrt(grid.weight[i]) * (f[i] >= 0.0 ? 1.0 : -1.0);
+    b[i] = f[i] * s;
   }
   // Householder QR, column by column; b transformed alongside.
   std::vector<double> diag(N);

@@ -54,5 +54,10 @@ std::vector<double> project(const WavelengthGrid& grid, const GreedyBasis& basis
 // equations would square their condition).
 std::vector<double> project_relative(const WavelengthGrid& grid, const GreedyBasis& basis,
                                      const std::vector<double>& f);
+// The same with the error measured relative to an envelope e > 0 instead of f
+// itself: for functions that cross zero (a centred power of kappa times
+// e^(-kappa D)), whose sum with the envelope's own term is what a pixel sees.
+std::vector<double> project_relative(const WavelengthGrid& grid, const GreedyBasis& basis, const std::vector<double>& f,
+                                     const std::vector<double>& envelope);
 
 }  // namespace nebula::spectral

@@ -113,14 +113,15 @@ struct SpectralSceneView {
   // thin-voxel limit P = tau_sct p_HG. Else P(a tau_V kappa, mu), which holds the
   // multiple scattering inside the voxel, is read at the attenuations
   // node_kappa[m], and P / kappa is interpolated in kappa by the polynomial
-  // sum_p B_p kappa^p through them (B_p = sum_m node_to_power[p][m] P_m /
-  // kappa_m): the pair's light is then sum_p B_p integral S_f kappa^(p+1) s
+  // sum_p B_p (kappa - kappa_c)^p through them (B_p = sum_m node_to_power[p][m] P_m /
+  // kappa_m): the pair's light is then sum_p B_p integral S_f kappa (kappa - kappa_c)^p s
   // e^(-kappa D) dlambda, and each power p has its own block of the coefficient
   // tables (coeff, star_coeff: n_powers blocks, the model's). Double reads P at
   // each of its wavelengths instead (the reference the nodes are measured against).
   TableView table;
   int n_nodes = 0;
   int n_powers = 1;
+  float kappa_center = 0;  // the powers are of kappa - kappa_center (SpectralModel)
   float node_kappa[kMaxTableNodes] = {};
   float node_to_power[kMaxTableNodes * kMaxTableNodes] = {};
   // Emission (docs/spectral.md, "Emission"): a voxel adds w(x) phi(lambda) seen
@@ -136,6 +137,17 @@ struct SpectralSceneView {
   const double* emission_breaks = nullptr;         // Analytic: [component][filter][segments + 1]
   const double* emission_coefficients = nullptr;   // Analytic: [component][filter][segments][degree + 1]
   const float* emission_coeff = nullptr;           // basis methods: [d][j]
+  // Light scattered between voxels (docs/spectral.md, "Light between voxels"),
+  // from the band renderer's diffuse field baked star by star at the nodes'
+  // attenuations: diffuse[(cell * n_stars + k) * (n_nodes + 1) + ...] = the
+  // weights B_p of star k's light in the voxel on the powers of kappa - kappa_c
+  // (n_nodes) and their depth D_d: the voxel adds L_k (c/l) sum_p B_p integral
+  // S_f kappa (kappa - kappa_c)^p s_k e^(-kappa (D_eye + D_d)) dlambda, a pair of
+  // star k's at optical path D_eye + D_d. eye_tau[cell]: the voxel's V-band
+  // depth as the eye sees through it, the field's forward peak taken out
+  // (diffuse_eye_depth). Null: none.
+  const float* diffuse = nullptr;
+  const float* eye_tau = nullptr;
 };
 
 // Henyey-Greenstein phase function per steradian.
@@ -144,8 +156,8 @@ NEBULA_HD float hg_phase(float mu, float g) {
   return (1.0f - g * g) * kInv4Pi / (d * sqrtf(d));
 }
 
-// One voxel-star pair's weights on the powers of kappa: its light through
-// filter f is sum_p b[p] integral S_f kappa^(p+1) s e^(-kappa D) dlambda. w is
+// One voxel-star pair's weights on the powers of kappa - kappa_c: its light through
+// filter f is sum_p b[p] integral S_f kappa (kappa - kappa_c)^p s e^(-kappa D) dlambda. w is
 // the thin-limit weight L/(4 pi) <1/r^2> a tau_V p_HG(mu) c/l: alone (b[0] = w)
 // without a table; with one, scale = w / (a tau_V p_HG) turns P(tau_sct, u) into
 // the pair's weight at an attenuation (Double's exact lookups use it too).
@@ -180,6 +192,58 @@ NEBULA_HD PairWeights pair_weights(const SpectralSceneView& s, float w, float ta
   }
   p.n = s.n_nodes;
   return p;
+}
+
+// D_d's bound (diffuse_voxel_terms): a noisy node ratio must not make the
+// weights e^(kappa D_d) huge (their sum with e^(-kappa D) is the light; the
+// basis methods drop pairs beyond their table's depth). Light reddened by more
+// than tau_V 4 keeps the rest of its slope in the polynomial.
+constexpr float kMaxDiffuseDepth = 4.0f;
+
+// Light between voxels: one star's terms in a voxel (SpectralSceneView::diffuse)
+// from what the band renderer's per-view pass gives at the nodes' attenuations
+// kappa_m for a field baked from that star alone with spectral power power[m] =
+// L s(lambda_m) (L_sun um^-1): H[m], the light the voxel scatters towards the
+// eye per unit of chord / l. The voxel's light at wavelength lambda is
+// L s(lambda) kappa u(kappa), u(kappa_m) = H[m] / (power[m] kappa_m) (the
+// transport depends on lambda only through kappa: albedo and g are the same at
+// every wavelength), and u is fitted as e^(-kappa D_d) sum_p B_p (kappa - kappa_c)^p:
+// D_d from the outer nodes' ratio (light that reached the voxel through dust is
+// redder: u falls with kappa), bounded by kMaxDiffuseDepth, then the polynomial
+// through u_m e^(kappa_m D_d). Exact at the nodes, and between them for an
+// exponential times a constant (or a polynomial of degree n_nodes - 1 that does
+// not fall). out: B_0 .. B_(n-1), D_d.
+NEBULA_HD void diffuse_voxel_terms(const SpectralSceneView& s, const float* H, const float* power, float* out) {
+  const int n = s.n_nodes;
+  float u[kMaxTableNodes], w[kMaxTableNodes];
+  for (int m = 0; m < n; ++m) u[m] = power[m] > 0.0f ? fmaxf(H[m], 0.0f) / (power[m] * s.node_kappa[m]) : 0.0f;
+  float D = 0.0f;
+  if (n >= 2 && u[0] > 0.0f && u[n - 1] > 0.0f)
+    D = fminf(fmaxf(0.0f, logf(u[0] / u[n - 1]) / (s.node_kappa[n - 1] - s.node_kappa[0])), kMaxDiffuseDepth);
+  for (int m = 0; m < n; ++m) w[m] = u[m] * expf(s.node_kappa[m] * D);
+  for (int p = 0; p < n; ++p) {
+    float b = 0.0f;
+    for (int m = 0; m < n; ++m) b += s.node_to_power[p * kMaxTableNodes + m] * w[m];
+    out[p] = b;
+  }
+  out[n] = D;
+}
+
+// The voxel's V-band depth as the eye sees through it with the field's forward
+// peak peak[m] at the nodes (the same for every star: the response of the
+// voxel's table, p_(N+1)(a tau kappa_m)). The band marcher's transmittance is
+// e^(-tau kappa c/l) + peak c/l; here it is matched at the V band over a whole
+// voxel, tau_eye = -ln(e^(-tau_V) + pi(1)) with pi(kappa) / kappa interpolated
+// between the nodes, and e^(-kappa tau_eye c/l) scales with kappa as the thin
+// voxel's peak a tau kappa g^(N+1) does (docs/spectral.md).
+NEBULA_HD float diffuse_eye_depth(const SpectralSceneView& s, const float* peak, float tau_v) {
+  if (!(tau_v > 0.0f)) return 0.0f;
+  float pi = 0.0f, xp = 1.0f;  // the polynomial through peak_m / kappa_m, at kappa = 1
+  for (int p = 0; p < s.n_nodes; ++p, xp *= 1.0f - s.kappa_center)
+    for (int m = 0; m < s.n_nodes; ++m) pi += s.node_to_power[p * kMaxTableNodes + m] * peak[m] / s.node_kappa[m] * xp;
+  pi = fmaxf(pi, 0.0f);
+  const float tau_eye = tau_v < 20.0f ? tau_v - log1pf(pi * expf(tau_v)) : -logf(pi + expf(-tau_v));
+  return fminf(fmaxf(tau_eye, 0.0f), tau_v);
 }
 
 // Calls f(i) for i = 0 .. n - 1. kBound > 0 is a compile-time bound on n: the
@@ -304,7 +368,18 @@ NEBULA_HD void add_pair(const SpectralSceneView& s, int star, const PairWeights&
       break;
     }
     case SpectralMethod::Analytic: {
-      // integral P_poly(lambda) kappa^(p+1) e^(-kappa D), kappa = C_T / lambda: C_T^(p+1) sum_k c_k I_(k-1-p).
+      // integral P_poly(lambda) kappa^(p+1) e^(-kappa D), kappa = C_T / lambda: C_T^(p+1) sum_k c_k I_(k-1-p),
+      // with the weights on the powers of kappa - kappa_c expanded on those of kappa (exact here:
+      // no table to fit, the closed form takes any power).
+      double mono[kMaxTableNodes] = {};
+      for (int p = 0; p < w.n; ++p) {
+        double binomial = 1.0, shift = 1.0;  // C(p, q) (-kappa_c)^(p - q), q from p down
+        for (int q = p; q >= 0; --q) {
+          mono[q] += double(w.b[p]) * binomial * shift;
+          binomial = binomial * q / double(p - q + 1);
+          shift *= -double(s.kappa_center);
+        }
+      }
       const double a = s.C_T * double(D);
       for_each_index<Acc::kCols>(s.n_acc, [&](int f) {
         const size_t pf = size_t(star) * s.n_acc + f;
@@ -318,7 +393,7 @@ NEBULA_HD void add_pair(const SpectralSceneView& s, int star, const PairWeights&
               const double ck = c[seg * (s.degree + 1) + k];
               if (ck != 0.0) sum += ck * power_exp_integral(k - 1 - p, a, b[seg], b[seg + 1]);
             }
-          total += double(w.b[p]) * C_T_power * sum;
+          total += mono[p] * C_T_power * sum;
         }
         acc(0, f) += float(total);
       });
@@ -359,6 +434,35 @@ NEBULA_HD void add_pair(const SpectralSceneView& s, int star, const PairWeights&
         for_each_index<kMaxTableNodes>(w.n, [&](int p) { add_block(p, w.b[p]); });
       break;
     }
+  }
+}
+
+// Light between voxels: star k's terms in the voxel (diffuse_voxel_terms)
+// added as a pair of the star's at V-band depth eye_depth + D_d, with weights
+// L_k fraction B_p (VoxelLight adds them in its pre-pass).
+template <SpectralMethod kMethod, class Acc>
+NEBULA_HD void add_diffuse(const SpectralSceneView& s, int k, size_t cell, float fraction, float eye_depth, Acc& acc) {
+  const int n = s.n_nodes;
+  const float* t = s.diffuse + (cell * s.n_stars + k) * size_t(n + 1);
+  PairWeights w;
+  w.n = n;
+  w.scale = w.tau_sct = w.u = 0.0f;
+  const float scale = s.stars[k].power * fraction;
+  NEBULA_UNROLL
+  for (int p = 0; p < kMaxTableNodes; ++p) w.b[p] = p < n ? scale * t[p] : 0.0f;
+  const float D = eye_depth + t[n];
+  if constexpr (kMethod == SpectralMethod::Double) {
+    // sum_p B_p (kappa - kappa_c)^p at each wavelength (q holds S kappa s dlambda).
+    const float* q = s.q + size_t(k) * s.n_acc * s.n_lambda;
+    for (int i = 0; i < s.n_lambda; ++i) {
+      const float x = s.kappa[i] - s.kappa_center;
+      float poly = 0.0f, xp = 1.0f;
+      for (int p = 0; p < n; ++p, xp *= x) poly += w.b[p] * xp;
+      const float e = poly * expf(-s.kappa[i] * D);
+      for_each_index<Acc::kCols>(s.n_acc, [&](int f) { acc(0, f) += q[f * s.n_lambda + i] * e; });
+    }
+  } else {
+    add_pair<kMethod>(s, k, w, D, acc);
   }
 }
 
@@ -506,6 +610,33 @@ NEBULA_HD void add_pair_light(const SpectralSceneView& s, float* __restrict__ u,
   }
 }
 
+// VoxelLight: star k's light between voxels in the voxel into its centre's
+// sums u[i] (i < F N; no gradient: the field's light is the voxel's own),
+// L_k sum_p B_p Q^p(k, D_d); the march weighs it by c_j(D_eye) as the star's
+// direct light.
+template <int kFN = 0>
+NEBULA_HD void add_diffuse_light(const SpectralSceneView& s, float* __restrict__ u, int k, size_t cell) {
+  const int n = s.n_nodes, FN = s.n_acc * s.n_basis;
+  const float* t = s.diffuse + (cell * s.n_stars + k) * size_t(n + 1);
+  const float x = t[n] / s.depth_step;
+  if (!(x < float(s.n_depth - 1))) return;  // beyond the table: below the transmittance cut
+  const int d0 = int(x);
+  const float fd = x - float(d0);
+  const size_t block = size_t(s.n_depth) * FN;
+  const float* q0 = s.star_coeff + star_row(s, k, 0, d0);
+  const float power = s.stars[k].power;
+  NEBULA_UNROLL
+  for (int i = 0; i < (kFN > 0 ? kFN : FN); ++i) {
+    if (kFN > 0 && i >= FN) break;
+    float v = 0.0f;
+    for_each_index<kMaxTableNodes>(n, [&](int p) {
+      const float* q = q0 + size_t(p) * block;
+      v += t[p] * (q[i] + fd * (q[FN + i] - q[i]));
+    });
+    u[i] += power * v;
+  }
+}
+
 // VoxelLight's per-view pre-pass for voxels x0 .. x0 + kRow - 1 (those below
 // the grid's edge) of row (y, z): U = a tau_V sum_k L_k/(4 pi r^2) p_HG(mu)
 // Q(star k, D_k) at each voxel's centre and its gradient (analytic: 1/r^2 and
@@ -544,6 +675,8 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
       if (p.w == 0.0f) continue;
       add_pair_light<kFN>(s, u, kFN, k, tau, p.w, p.gx, p.gy, p.gz, p.x, p.mu);
     }
+    if (s.diffuse && tau > 0.0f)
+      for (int k = 0; k < s.n_stars; ++k) add_diffuse_light<kFN>(s, u, k, cell0);
     float* out = light + cell0 * 4 * FN;
     for_each_index<kFN>(FN, [&](int i) {
       out[i] = u[i];
@@ -594,6 +727,8 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
         if (w[k][i] == 0.0f) continue;
         add_pair_light(s, u, FN, k, tau[i], w[k][i], gx[k][i], gy[k][i], gz[k][i], xd[k][i], mu[k][i]);
       }
+      if (s.diffuse && tau[i] > 0.0f)
+        for (int k = 0; k < s.n_stars; ++k) add_diffuse_light(s, u, k, cell0 + i);
       unsigned mask = 0;
       for (int k = 0; k < s.n_stars; ++k) mask |= unsigned(is_near[k][i] != 0.0f) << k;
       near[cell0 + i] = mask;
@@ -668,11 +803,13 @@ NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir,
         const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
         const float w = s.stars[k].power * kInv4Pi * at.inv_r2 * s.albedo * tau_v * hg_phase(mu, s.g) * fraction;
         add_pair<kMethod>(s, k, pair_weights(s, w, tau_v, mu), s.stars[k].depth_v[cell] + eye_depth, acc);
+        if (s.diffuse) add_diffuse<kMethod>(s, k, cell, fraction, eye_depth, acc);
       });
     }
     if (s.n_emission > 0) add_emission<kMethod>(s, cell, tau_v, fraction, eye_depth, em);
     t += chord;
-    eye_depth += tau_v * fraction;
+    // The eye sees through the voxel's dust less its diffuse field's forward peak (diffuse_eye_depth).
+    eye_depth += (s.eye_tau ? s.eye_tau[cell] : tau_v) * fraction;
     return eye_depth < s.max_eye_depth;
   });
 }

@@ -40,6 +40,7 @@ double mean_over_v(const std::function<double(double)>& f) {
 void set_table_nodes(SpectralModel& m, int nodes, double kappa_min, double kappa_max) {
   m.node_kappa.clear();
   m.node_to_power.clear();
+  m.kappa_center = 0.0;
   m.n_powers = std::max(nodes, 1);
   if (nodes == 0) return;
   if (nodes == 1) {
@@ -48,11 +49,12 @@ void set_table_nodes(SpectralModel& m, int nodes, double kappa_min, double kappa
     return;
   }
   for (int k = 0; k < nodes; ++k) m.node_kappa.push_back(kappa_min + (kappa_max - kappa_min) * k / (nodes - 1));
-  // V[k][p] = kappa_k^p (distinct nodes, at most 4: well posed); row p of V^-1
-  // gives the coefficient of kappa^p.
+  m.kappa_center = 0.5 * (kappa_min + kappa_max);
+  // V[k][p] = (kappa_k - kappa_c)^p (distinct nodes, at most 4: well posed); row p of V^-1
+  // gives the coefficient of (kappa - kappa_c)^p.
   Eigen::MatrixXd V(nodes, nodes);
   for (int k = 0; k < nodes; ++k)
-    for (int p = 0; p < nodes; ++p) V(k, p) = std::pow(m.node_kappa[k], p);
+    for (int p = 0; p < nodes; ++p) V(k, p) = std::pow(m.node_kappa[k] - m.kappa_center, p);
   const Eigen::MatrixXd inverse = V.fullPivLu().inverse();
   for (int p = 0; p < nodes; ++p)
     for (int k = 0; k < nodes; ++k) m.node_to_power.push_back(inverse(p, k));
@@ -117,6 +119,19 @@ double SpectralStar::shape(double lambda) const {
 double SpectralModel::kappa_at(double lambda) const {
   if (settings.attenuation == Attenuation::Inverse) return C_T / lambda;
   return extinction_ratio_at(lambda * 1000.0, settings.R_V, settings.law) / C_T;
+}
+
+double SpectralModel::wavelength_of_kappa(double kappa) const {
+  size_t best = 0;
+  for (size_t i = 1; i < grid.lambda.size(); ++i)
+    if (std::fabs(kappa_grid[i] - kappa) < std::fabs(kappa_grid[best] - kappa)) best = i;
+  // Between the closest node and the neighbour on the side of kappa, where kappa is monotonic there.
+  for (size_t j : {best > 0 ? best - 1 : best, best + 1 < grid.lambda.size() ? best + 1 : best}) {
+    const double k0 = kappa_grid[best], k1 = kappa_grid[j];
+    if (j != best && (kappa - k0) * (kappa - k1) <= 0.0 && k0 != k1)
+      return grid.lambda[best] + (kappa - k0) / (k1 - k0) * (grid.lambda[j] - grid.lambda[best]);
+  }
+  return grid.lambda[best];
 }
 
 SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Passband>>& filters,
@@ -272,15 +287,20 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
       const int D = settings.depth_nodes;
       m.depth_step = float(m.max_depth / (D - 1));
       std::vector<double> f(m.grid.lambda.size());
-      // A block per power p of kappa (tables, spectral_march.h): kappa^p s_T e^(-kappa D) on the basis.
+      // A block per power p of kappa - kappa_c (tables, spectral_march.h): (kappa - kappa_c)^p s_T e^(-kappa D)
+      // on the basis, its error relative to p = 0's function (the envelope: a centred power crosses zero).
+      std::vector<double> envelope(m.grid.lambda.size());
       for (int p = 0; p < m.n_powers; ++p)
         for (int t = 0; t < m.n_temperature; ++t) {
           const double T = temperature_at(t, m.n_temperature);
           for (int d = 0; d < D; ++d) {
-            for (size_t i = 0; i < f.size(); ++i)
-              f[i] = (light ? planck_shape(m.grid.lambda[i], T) : 1.0) * std::pow(m.kappa_grid[i], p) *
-                     std::exp(-m.kappa_grid[i] * d * m.depth_step);
-            for (double c : settings.relative ? project_relative(m.grid, m.basis, f) : project(m.grid, m.basis, f))
+            for (size_t i = 0; i < f.size(); ++i) {
+              envelope[i] =
+                  (light ? planck_shape(m.grid.lambda[i], T) : 1.0) * std::exp(-m.kappa_grid[i] * d * m.depth_step);
+              f[i] = envelope[i] * std::pow(m.kappa_grid[i] - m.kappa_center, p);
+            }
+            for (double c : settings.relative ? project_relative(m.grid, m.basis, f, envelope)
+                                              : project(m.grid, m.basis, f))
               m.coeff.push_back(float(c));
           }
         }
@@ -416,13 +436,13 @@ void build_star_tables(SpectralModel& m) {
         for (int j = 0; j < n; ++j) h[(size_t(s) * F + f) * n + j][i] = base * m.basis.phi[j][i];
       }
   m.n_acc = F;
-  const int P = m.n_powers;  // tables: a block per power of kappa, Q^p = integral S_f kappa^(p+1) s e^(-kappa D) phi_j
+  const int P = m.n_powers;  // tables: a block per power, Q^p = integral S_f kappa (kappa - kappa_c)^p s e^(-kappa D) phi_j
   m.star_coeff.assign(size_t(S) * P * D * F * n, 0.0f);
   std::vector<double> e(G);
   for (int p = 0; p < P; ++p)
     for (int d = 0; d < D; ++d) {
       for (size_t i = 0; i < G; ++i)
-        e[i] = std::pow(m.kappa_grid[i], p) * std::exp(-m.kappa_grid[i] * d * double(m.depth_step));
+        e[i] = std::pow(m.kappa_grid[i] - m.kappa_center, p) * std::exp(-m.kappa_grid[i] * d * double(m.depth_step));
       for (int s = 0; s < S; ++s)
         for (int fj = 0; fj < F * n; ++fj) {
           const std::vector<double>& row = h[size_t(s) * F * n + fj];
@@ -497,6 +517,7 @@ SpectralSceneView view_of(const SpectralModel& m) {
   v.coeff = m.coeff.data();
   v.star_coeff = m.star_coeff.data();
   v.n_powers = m.n_powers;
+  v.kappa_center = float(m.kappa_center);
   for (size_t i = 0; i < m.node_kappa.size(); ++i) v.node_kappa[i] = float(m.node_kappa[i]);
   const int K = int(m.node_kappa.size());
   for (int p = 0; p < K; ++p)

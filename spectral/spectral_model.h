@@ -111,8 +111,11 @@ struct SpectralModel {
   float max_eye_depth = 1e30f;
   std::vector<float> resolve;  // [filter][acc]
   // Tables: the nodes' attenuations and the map from P / kappa at them to the
-  // powers of kappa ([p][m]); n_powers blocks in coeff and star_coeff.
+  // coefficients of the powers of kappa - kappa_center ([p][m]), the middle of
+  // the nodes' range (centred powers: small beside the constant term, so a sum
+  // over them does not cancel); n_powers blocks in coeff and star_coeff.
   std::vector<double> node_kappa, node_to_power;
+  double kappa_center = 0;
   int n_powers = 1;
   // Emission: its planes follow the n_acc star planes (the resolve's columns
   // n_acc .. n_acc + n_emission_planes - 1; spectral_march.h, add_emission).
@@ -124,6 +127,9 @@ struct SpectralModel {
   std::vector<float> emission_coeff;   // LightBasis: e^(-kappa D) on the basis, [d][j] (else coeff's first block)
   int planes() const { return n_acc + n_emission_planes; }
   double kappa_at(double lambda_um) const;
+  // A wavelength (um) in the basis' range where kappa(lambda) = kappa (the
+  // closest on the inner products' grid, refined between its neighbours).
+  double wavelength_of_kappa(double kappa) const;
 };
 
 // Errors (ParameterError-free: callers name their keys): no filter, a filter

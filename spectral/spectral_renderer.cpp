@@ -26,6 +26,26 @@ void check(const SpectralRenderInputs& in) {
   for (const SpectralEmissionWeight& e : in.emission)
     if (e.grid && e.grid->size() != in.density->shape.count())
       throw Error("spectral render: an emission weight grid does not have the density's shape");
+  if (const SpectralDiffuseLight* d = in.diffuse) {
+    const SpectralModel& m = *in.model;
+    const size_t n = size_t(m.settings.table_nodes), voxels = in.density->shape.count();
+    if (!in.table || n < 1)
+      throw Error("spectral render: light between voxels needs the voxels' table (table_nodes >= 1)");
+    const bool device = d->on_device();
+    bool sizes = d->node_power.size() == in.lights.size() &&
+                 (device ? d->device_light.size() == in.lights.size() && d->device_peak.size() == n
+                         : d->light.size() == in.lights.size() && d->peak.size() == n);
+    for (size_t k = 0; sizes && k < in.lights.size(); ++k) {
+      sizes = (device ? d->device_light[k].size() : d->light[k].size()) == n && d->node_power[k].size() == n;
+      for (size_t j = 0; sizes && j < n; ++j)
+        sizes = device ? d->device_light[k][j].holds(voxels * sizeof(float)) : d->light[k][j].size() == voxels;
+    }
+    for (size_t j = 0; sizes && j < n; ++j)
+      sizes = device ? d->device_peak[j].holds(voxels * sizeof(float)) : d->peak[j].size() == voxels;
+    if (!sizes)
+      throw Error("spectral render: the light between voxels is not one array per star and table node (" +
+                  std::to_string(n) + ") of the density's shape");
+  }
   if (in.table && in.model->settings.table_nodes > 0 &&
       (std::fabs(in.table->albedo - in.albedo) > 1e-6 || std::fabs(in.table->g - in.g) > 1e-6))
     throw Error("spectral render: the table is for albedo " + to_text(in.table->albedo) + ", g " +
@@ -48,6 +68,45 @@ void set_emission(SpectralSceneView& view, const SpectralRenderInputs& in, const
   }
 }
 
+DiffuseTerms diffuse_terms(const SpectralRenderInputs& in, const SpectralSceneView& view) {
+  if (!in.diffuse) return {};
+  const int n = view.n_nodes, S = int(in.lights.size());
+  const size_t voxels = in.density->shape.count();
+  SpectralDiffuseLight downloaded;  // a CUDA pass' arrays, for the CPU
+  if (in.diffuse->on_device()) {
+    const auto fetch = [&](const DeviceMirror& m) {
+      std::vector<float> host(voxels);
+      m.download(host.data(), voxels * sizeof(float));
+      return host;
+    };
+    for (const auto& star : in.diffuse->device_light) {
+      downloaded.light.emplace_back();
+      for (const DeviceMirror& m : star) downloaded.light.back().push_back(fetch(m));
+    }
+    for (const DeviceMirror& m : in.diffuse->device_peak) downloaded.peak.push_back(fetch(m));
+    downloaded.node_power = in.diffuse->node_power;
+  }
+  const SpectralDiffuseLight& d = in.diffuse->on_device() ? downloaded : *in.diffuse;
+  DiffuseTerms out;
+  out.terms.resize(voxels * S * size_t(n + 1));
+  out.eye_tau.resize(voxels);
+  tbb::parallel_for(size_t(0), voxels, size_t(8192), [&](size_t v0) {
+    for (size_t v = v0; v < std::min(voxels, v0 + 8192); ++v) {
+      float H[kMaxTableNodes], power[kMaxTableNodes], peak[kMaxTableNodes];
+      for (int k = 0; k < S; ++k) {
+        for (int m = 0; m < n; ++m) {
+          H[m] = d.light[size_t(k)][size_t(m)][v];
+          power[m] = float(d.node_power[size_t(k)][size_t(m)]);
+        }
+        diffuse_voxel_terms(view, H, power, &out.terms[(v * S + k) * size_t(n + 1)]);
+      }
+      for (int m = 0; m < n; ++m) peak[m] = d.peak[size_t(m)][v];
+      out.eye_tau[v] = diffuse_eye_depth(view, peak, in.density->tau_v[v]);
+    }
+  });
+  return out;
+}
+
 Image render_spectral(const SpectralRenderInputs& in, Backend backend, double* seconds) {
   check(in);
   return backend == Backend::Cuda ? render_spectral_cuda(in, seconds) : render_spectral_cpu(in, seconds);
@@ -68,6 +127,12 @@ Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds) {
   view.g = in.g;
   view.footprint = in.camera.footprint();
   set_table(view, in, in.table ? in.table->P.data() : nullptr);
+  const auto start = std::chrono::steady_clock::now();  // the per-view work is timed with the march
+  const DiffuseTerms diffuse = diffuse_terms(in, view);
+  if (in.diffuse) {
+    view.diffuse = diffuse.terms.data();
+    view.eye_tau = diffuse.eye_tau.data();
+  }
   std::vector<const float*> grids;
   for (const SpectralEmissionWeight& e : in.emission) grids.push_back(e.grid ? e.grid->data() : nullptr);
   set_emission(view, in, grids);
@@ -82,7 +147,6 @@ Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds) {
     work.near.resize(g.count());
     view.near_distance = float(m.settings.near_voxels) * g.voxel;
   }
-  const auto start = std::chrono::steady_clock::now();
   if (m.settings.method == SpectralMethod::VoxelLight) {  // the per-view pre-pass (timed with the march)
     constexpr int kRow = 16;  // voxels side by side in the vectorised geometry
     tbb::parallel_for(tbb::blocked_range<int>(0, g.nz * g.ny), [&](const auto& rows) {

@@ -35,6 +35,23 @@ struct SpectralEmissionWeight {
   float scale = 1;
 };
 
+// Light scattered between voxels (docs/spectral.md, "Light between voxels"):
+// the band renderer's diffuse field baked star by star at the model's table
+// nodes (one band per node, kappa_m, the star's spectral power at a wavelength
+// of that kappa) and its per-view pass for this camera (raycast/renderer.h,
+// diffuse_light_arrays).
+struct SpectralDiffuseLight {
+  std::vector<std::vector<std::vector<float>>> light;  // [star][node][voxel]: towards the eye, per unit chord / l
+  std::vector<std::vector<float>> peak;                // [node][voxel]: the forward peak (the same for every star)
+  // The same arrays on the device, from a CUDA per-view pass ([star][node] and
+  // [node], each of the grid's voxels; the host arrays then empty): the CUDA
+  // renderer reads them where they are, the CPU's downloads them.
+  std::vector<std::vector<DeviceMirror>> device_light;
+  std::vector<DeviceMirror> device_peak;
+  std::vector<std::vector<double>> node_power;         // [star][node]: its pass' power, L_sun um^-1
+  bool on_device() const { return light.empty() && !device_light.empty(); }
+};
+
 struct SpectralRenderInputs {
   const DensityGrid* density = nullptr;
   const SpectralModel* model = nullptr;  // built for these lights, in this order
@@ -45,12 +62,14 @@ struct SpectralRenderInputs {
   // with table_nodes 0: the thin-voxel limit P = tau_sct p_HG.
   const ScatteringTable* table = nullptr;
   std::vector<SpectralEmissionWeight> emission;  // one per model->emission component
+  // With a table and table nodes (the model's); null: none.
+  const SpectralDiffuseLight* diffuse = nullptr;
   Camera camera;
   VoxelLightWorkspace* workspace = nullptr;  // VoxelLight on the CPU: reused buffers (optional)
 };
 
-// The accumulator image (model->planes(): the stars', then the emission's); `seconds` the march alone
-// (CUDA events on the GPU). Throws Error on inconsistent inputs (a table for
+// The accumulator image (model->planes(): the stars', then the emission's); `seconds` the march with
+// its per-view work (the voxel-light pre-pass, the light between voxels' terms; CUDA events on the GPU). Throws Error on inconsistent inputs (a table for
 // another albedo or g than the dust's among them).
 Image render_spectral(const SpectralRenderInputs& in, Backend backend, double* seconds = nullptr);
 Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds);
@@ -58,6 +77,15 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds);
 
 // One plane per filter (the model's names), times the exposure.
 Image resolve_filters(const Image& accumulators, const SpectralModel& model, float exposure = 1.0f);
+
+// The per-voxel terms of the light between voxels (SpectralSceneView::diffuse
+// and eye_tau: diffuse_voxel_terms, diffuse_eye_depth) on the host (the CPU
+// renderer's; the CUDA renderer runs the same functions in a kernel); empty
+// without it.
+struct DiffuseTerms {
+  std::vector<float> terms, eye_tau;
+};
+DiffuseTerms diffuse_terms(const SpectralRenderInputs& in, const SpectralSceneView& view);
 
 // The scene view's emission weights (`grids[c]`: component c's grid where it
 // lives, host or device, or null for tau_V).

@@ -41,6 +41,27 @@ __global__ void voxel_light_kernel(SpectralSceneView scene, Camera camera, float
   voxel_light<1, kFN>(scene, camera, x, y, z, light, near);
 }
 
+// Light between voxels: each voxel's terms per star and its eye-side depth
+// (diffuse_voxel_terms, diffuse_eye_depth), one voxel per thread, from the
+// per-view arrays light[k * n + m] (star k, node m) and peak[m] where they lie
+// on the device; power[k * n + m] the star's pass' power at the node.
+__global__ void diffuse_terms_kernel(SpectralSceneView scene, const float* const* light, const float* const* peak,
+                                     const float* power, int stars, float* terms, float* eye_tau) {
+  const size_t v = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (v >= scene.density.shape.count()) return;
+  const int n = scene.n_nodes;
+  float H[kMaxTableNodes], P[kMaxTableNodes], pk[kMaxTableNodes];
+  for (int k = 0; k < stars; ++k) {
+    for (int m = 0; m < n; ++m) {
+      H[m] = light[k * n + m][v];
+      P[m] = power[k * n + m];
+    }
+    diffuse_voxel_terms(scene, H, P, terms + (v * stars + k) * size_t(n + 1));
+  }
+  for (int m = 0; m < n; ++m) pk[m] = peak[m][v];
+  eye_tau[v] = diffuse_eye_depth(scene, pk, scene.density.tau_v[v]);
+}
+
 // The smallest of the bounds in `sizes` that holds n, or 0 (run-time extents).
 template <int... kSizes>
 constexpr int bucket(int n) {
@@ -115,6 +136,33 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
   view.g = in.g;
   view.footprint = in.camera.footprint();
   if (in.table) set_table(view, in, upload(floats, in.table->P));
+  // Light between voxels: the per-view arrays where they lie (a CUDA pass leaves them on the
+  // device; host arrays are uploaded here), the terms made by a kernel timed with the march.
+  const size_t cells = in.density->shape.count();
+  std::vector<const float*> light_ptrs, peak_ptrs;
+  std::vector<float> powers;
+  DeviceArray<float> terms(in.diffuse ? cells * in.lights.size() * size_t(view.n_nodes + 1) : 0);
+  DeviceArray<float> eye_tau(in.diffuse ? cells : 0);
+  std::vector<std::shared_ptr<const void>> mirrored;  // the device copies' owners, alive for the kernel
+  if (const SpectralDiffuseLight* d = in.diffuse) {
+    const auto device_of = [&](const DeviceMirror& mirror) {  // check() made sure it holds the array
+      const DeviceMirror::Copy c = mirror.current();
+      mirrored.push_back(c.owner);
+      return static_cast<const float*>(c.device);
+    };
+    for (size_t k = 0; k < in.lights.size(); ++k)
+      for (int m = 0; m < view.n_nodes; ++m) {
+        light_ptrs.push_back(d->on_device() ? device_of(d->device_light[k][size_t(m)])
+                                            : upload(floats, d->light[k][size_t(m)]));
+        powers.push_back(float(d->node_power[k][size_t(m)]));
+      }
+    for (int m = 0; m < view.n_nodes; ++m)
+      peak_ptrs.push_back(d->on_device() ? device_of(d->device_peak[size_t(m)]) : upload(floats, d->peak[size_t(m)]));
+    view.diffuse = terms.get();
+    view.eye_tau = eye_tau.get();
+  }
+  DeviceArray<const float*> light_table(light_ptrs), peak_table(peak_ptrs);
+  const DeviceArray<float> power(powers);
   view.kappa = upload(floats, m.kappa);
   view.q = upload(floats, m.q);
   view.coeff = upload(floats, m.coeff);
@@ -129,7 +177,6 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
   for (const SpectralEmissionWeight& e : in.emission) grids.push_back(e.grid ? upload(floats, *e.grid) : nullptr);
   set_emission(view, in, grids);
   const bool voxel = m.settings.method == SpectralMethod::VoxelLight;
-  const size_t cells = in.density->shape.count();
   DeviceArray<float> light(voxel ? cells * 4 * size_t(m.n_acc) * m.basis.size() : 0);
   DeviceArray<unsigned> near(voxel ? cells : 0);
   if (voxel) {
@@ -144,6 +191,10 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
   const dim3 block(16, 16), grid((in.camera.width + 15) / 16, (in.camera.height + 15) / 16);
   CudaEventTimer timer;
   const unsigned pre_blocks = unsigned((cells + 255) / 256);
+  if (in.diffuse) {
+    diffuse_terms_kernel<<<pre_blocks, 256>>>(view, light_table.get(), peak_table.get(), power.get(),
+                                              int(in.lights.size()), terms.get(), eye_tau.get());
+  }
   if (voxel) {  // the pre-pass, timed with the march
     const int FN = m.n_acc * int(m.basis.size());
     if (FN <= 16)

@@ -1,6 +1,7 @@
 #pragma once
 // A small scene the spectral renderer's tests share: a cube of noise dust
 // (tau_V per voxel up to `scale`), stars with baked depths, an oblique camera.
+#include <cmath>
 #include <vector>
 
 #include "core/camera.h"
@@ -25,6 +26,34 @@ struct SpectralTestScene {
     return in;
   }
 };
+
+// Light between voxels for a scene without baking a field: per star and
+// node, H = P kappa A e^(-kappa D) (1 + 0.3 kappa) with A and D smooth in the
+// voxel (D up to 3), P the star's spectral power at the node's wavelength, and
+// a forward peak 0.05 kappa tau_V (SpectralDiffuseLight's shapes).
+inline SpectralDiffuseLight synthetic_diffuse(const SpectralTestScene& s, const SpectralModel& m) {
+  SpectralDiffuseLight d;
+  const size_t voxels = s.grid.shape.count();
+  const size_t n = m.node_kappa.size();
+  d.peak.assign(n, std::vector<float>(voxels));
+  for (size_t j = 0; j < n; ++j)
+    for (size_t v = 0; v < voxels; ++v) d.peak[j][v] = 0.05f * float(m.node_kappa[j]) * s.grid.tau_v[v];
+  for (size_t k = 0; k < s.star_positions.size(); ++k) {
+    std::vector<double> power;
+    for (size_t j = 0; j < n; ++j) power.push_back(100.0 * m.stars[k].shape(m.wavelength_of_kappa(m.node_kappa[j])));
+    d.node_power.push_back(power);
+    d.light.emplace_back(n, std::vector<float>(voxels));
+    for (size_t v = 0; v < voxels; ++v) {
+      const float A = 1e-3f * (1.0f + 0.5f * std::sin(0.01f * float(v) + float(k)));
+      const float D = 1.5f + 1.5f * std::cos(0.003f * float(v));
+      for (size_t j = 0; j < n; ++j) {
+        const float kappa = float(m.node_kappa[j]);
+        d.light[k][j][v] = float(power[j]) * kappa * A * std::exp(-kappa * D) * (1.0f + 0.3f * kappa);
+      }
+    }
+  }
+  return d;
+}
 
 inline SpectralTestScene noise_scene(int n, float scale, std::vector<Vec3> stars, int width, int height) {
   SpectralTestScene s;
