@@ -19,13 +19,13 @@ import argparse
 import json
 import os
 import shutil
-import subprocess
 import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "validation"))
 from accuracy_report import write_densities  # noqa: E402  (the layer and wedge grids)
+from nebula_runner import Runner  # noqa: E402
 
 SCENES = ["fig12_reference", "thin_nebula", "thick_nebula", "layer_front", "layer_behind", "wedge", "sphere_tau1",
           "sphere_tau5", "axial_lopsided", "axial_lopsided_thick"]
@@ -45,23 +45,6 @@ def scene_path(work, name):
     if name == "fig12_reference":
         return os.path.join(ROOT, "scenes", name + ".toml")
     return os.path.join(work, name + ".toml")
-
-
-class Runner:
-    def __init__(self, args):
-        self.nebula = os.path.abspath(args.nebula)
-        self.work = os.path.abspath(args.work)
-        self.backend = args.backend
-        self.env = dict(os.environ, NEBULA_CACHE_DIR=os.path.join(self.work, "cache"))
-
-    def run(self, argv):
-        r = subprocess.run([self.nebula] + argv, capture_output=True, text=True, env=self.env, cwd=self.work)
-        if r.returncode != 0:
-            raise SystemExit(f"nebula {' '.join(argv)} failed ({r.returncode}): {r.stderr.strip()}")
-        return r.stdout
-
-    def compare(self, a, b):
-        return json.loads(self.run(["compare", a, b, "--json"]))["bands"]
 
 
 def main():

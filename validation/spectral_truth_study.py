@@ -22,11 +22,12 @@ import json
 import os
 import re
 import shutil
-import subprocess
 import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "validation"))
+from nebula_runner import Runner  # noqa: E402
 
 SCENES = ["fig12_reference", "sphere_tau1", "sphere_tau5"]
 FILTERS = {"n450": 450, "n550": 550, "n700": 700}
@@ -56,23 +57,6 @@ def write_scenes(work, name):
     return paths
 
 
-class Runner:
-    def __init__(self, args):
-        self.nebula = os.path.abspath(args.nebula)
-        self.work = os.path.abspath(args.work)
-        self.backend = args.backend
-        self.env = dict(os.environ, NEBULA_CACHE_DIR=os.path.join(self.work, "cache"))
-
-    def run(self, argv):
-        r = subprocess.run([self.nebula] + argv, capture_output=True, text=True, env=self.env, cwd=self.work)
-        if r.returncode != 0:
-            raise SystemExit(f"nebula {' '.join(argv)} failed ({r.returncode}): {r.stderr.strip()}")
-        return r.stdout
-
-    def compare(self, a, b):
-        return json.loads(self.run(["compare", a, b, "--json"]))["bands"]
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--nebula", default=os.path.join(ROOT, "build", "bin", "nebula"))
@@ -90,7 +74,6 @@ def main():
     for f in os.listdir(os.path.join(ROOT, "validation", "scenes")):
         shutil.copy(os.path.join(ROOT, "validation", "scenes", f), args.work)
     if any(s.startswith(("layer", "wedge")) for s in args.scenes.split(",")):
-        sys.path.insert(0, os.path.join(ROOT, "validation"))
         from accuracy_report import write_densities  # the layer and wedge grids (numpy, h5py)
         write_densities(args.work)
     r = Runner(args)
