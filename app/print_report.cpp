@@ -81,6 +81,10 @@ void print_spectral(const RunReport& r) {
     std::printf("  method: double integral, %d wavelength samples per voxel and star\n", s.wavelengths);
   } else if (s.method == "analytic") {
     std::printf("  method: analytic integral (exponential-integral recurrence) per voxel, star and filter\n");
+  } else if (s.method == "preintegrated") {
+    std::printf("  method: pre-integrated, the integral over wavelength tabulated per star and filter over optical "
+                "paths 0-%g (one lookup per voxel, star and filter)\n",
+                s.max_depth);
   } else {
     std::printf("  method: %s, %d basis element(s) (%s norm) fitted on optical paths 0-%g, table to %g; elements a =",
                 s.method == "projection"    ? "projection"

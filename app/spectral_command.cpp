@@ -371,7 +371,8 @@ void add_spectral_bench(CLI::App* bench) {
                    : s.method == spectral::SpectralMethod::Analytic   ? "analytic"
                    : s.method == spectral::SpectralMethod::Projection ? "projection"
                    : s.method == spectral::SpectralMethod::LightBasis ? "light_density"
-                                                                      : "voxel_light";
+                   : s.method == spectral::SpectralMethod::Preintegrated ? "preintegrated"
+                                                                         : "voxel_light";
         r.norm = s.relative ? "relative" : "absolute";
         r.basis = m.basis.size();
         r.table_nodes = table ? s.table_nodes : 0;
@@ -421,6 +422,8 @@ void add_spectral_bench(CLI::App* bench) {
         s.basis = n;
         row("voxel light, N = " + std::to_string(n), s);
       }
+      s.method = spectral::SpectralMethod::Preintegrated;  // no basis: the integral tabulated over D
+      row("pre-integrated", s);
       // Six spectra at the cost of one: each method with these stars against the same
       // method with the first star alone, frames alternated in one process (a shared
       // machine's load then weighs on both alike); medians of `repeats` pairs.
@@ -430,7 +433,7 @@ void add_spectral_bench(CLI::App* bench) {
         std::printf("%-30s %9s %9s %9s\n", "method", "1 star ms", "all ms", "ratio");
         std::vector<spectral::SpectralStar> first(stars.begin(), stars.begin() + 1);
         for (const auto method : {spectral::SpectralMethod::Projection, spectral::SpectralMethod::LightBasis,
-                                  spectral::SpectralMethod::VoxelLight}) {
+                                  spectral::SpectralMethod::VoxelLight, spectral::SpectralMethod::Preintegrated}) {
           spectral::SpectralSettings rs = base;
           rs.method = method;
           rs.basis = 4;
@@ -451,10 +454,13 @@ void add_spectral_bench(CLI::App* bench) {
           std::sort(t1.begin(), t1.end());
           std::sort(ta.begin(), ta.end());
           const double ms1 = t1[t1.size() / 2] * 1e3, msa = ta[ta.size() / 2] * 1e3;
-          const std::string name = method == spectral::SpectralMethod::Projection   ? "projection"
-                                   : method == spectral::SpectralMethod::LightBasis ? "light_density"
-                                                                                    : "voxel_light";
-          std::printf("%-30s %9.2f %9.2f %9.3f\n", (name + ", N = 4").c_str(), ms1, msa, msa / ms1);
+          const std::string name = method == spectral::SpectralMethod::Projection      ? "projection"
+                                   : method == spectral::SpectralMethod::LightBasis    ? "light_density"
+                                   : method == spectral::SpectralMethod::Preintegrated ? "preintegrated"
+                                                                                       : "voxel_light";
+          std::printf("%-30s %9.2f %9.2f %9.3f\n",
+                      (name + (method == spectral::SpectralMethod::Preintegrated ? "" : ", N = 4")).c_str(), ms1, msa,
+                      msa / ms1);
           ratio_json += std::string(ratio_json.empty() ? "" : ",") + "\n       {\"method\": " + json_string(name) +
                         ", \"basis\": 4, \"one_star_ms\": " + to_text(ms1) + ", \"all_stars_ms\": " + to_text(msa) +
                         ", \"ratio\": " + to_text(msa / ms1) + "}";

@@ -27,6 +27,7 @@ spectral::SpectralMethod method_of(const std::string& name) {
   if (name == "analytic") return spectral::SpectralMethod::Analytic;
   if (name == "light_density") return spectral::SpectralMethod::LightBasis;
   if (name == "voxel_light") return spectral::SpectralMethod::VoxelLight;
+  if (name == "preintegrated") return spectral::SpectralMethod::Preintegrated;
   return spectral::SpectralMethod::Projection;
 }
 

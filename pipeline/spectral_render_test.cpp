@@ -143,13 +143,15 @@ TEST_F(SpectralScene, FastMethodsAgainstTheDoubleIntegral) {
   const Image inverse_ref = render("method = \"double\"\nwavelengths = 400\nattenuation = \"inverse\"\n").image;
   const double analytic = worst_relative(render("method = \"analytic\"\nattenuation = \"inverse\"\n").image, inverse_ref);
   const double voxel = worst_relative(render("method = \"voxel_light\"\nbasis = 4\n").image, ref);
+  const double pre = worst_relative(render("method = \"preintegrated\"\n").image, ref);
   const RenderOutput thin = render("basis = 4\ntables = false\n");
   const double thin_error = worst_relative(thin.image, ref);
   std::printf("  largest pixel error against the double integral: projection (4) %.2e, light-density (6) %.2e, "
-              "analytic %.2e, voxel light (4) %.2e; the thin limit %.2e\n",
-              projection, light, analytic, voxel, thin_error);
+              "analytic %.2e, voxel light (4) %.2e, pre-integrated %.2e; the thin limit %.2e\n",
+              projection, light, analytic, voxel, pre, thin_error);
   EXPECT_LT(projection, 1e-2);
   EXPECT_LT(voxel, 1e-2);
+  EXPECT_LT(pre, 1e-2);
   EXPECT_LT(light, 1e-2);
   EXPECT_LT(analytic, 1e-2);
   EXPECT_GT(thin_error, 1e-2);

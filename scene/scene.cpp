@@ -149,11 +149,11 @@ std::optional<SceneIssue> filter_issue(const SceneFilter& f) {
 std::optional<SceneIssue> spectral_issue(const Scene& s) {
   const SpectralSpec& p = *s.spectral;
   const bool known_method = p.method == "double" || p.method == "analytic" || p.method == "projection" ||
-                            p.method == "light_density" || p.method == "voxel_light";
+                            p.method == "light_density" || p.method == "voxel_light" || p.method == "preintegrated";
   if (!known_method)
     return SceneIssue{"spectral.method", "'" + p.method +
                                              "' is not a method (known: double, analytic, projection, light_density, "
-                                             "voxel_light)"};
+                                             "voxel_light, preintegrated)"};
   if (p.basis < 1 || p.basis > 16)
     return SceneIssue{"spectral.basis", "is " + std::to_string(p.basis) + "; must be in 1..16 (basis elements)"};
   if (p.wavelengths < 2 || p.wavelengths > 4096)

@@ -142,9 +142,11 @@ TEST(SpectralDiffuse, MethodsAgreeOnTheSameLight) {
   const double projection = worst(render(SpectralMethod::Projection, 4, 20, true), ref);
   const double light = worst(render(SpectralMethod::LightBasis, 6, 20, true), ref);
   const double voxel = worst(render(SpectralMethod::VoxelLight, 4, 20, true), ref);
+  const double pre = worst(render(SpectralMethod::Preintegrated, 4, 20, true), ref);
   std::printf("  with light between voxels (%.0f%% of the image), largest pixel error against the double integral: "
-              "projection (4) %.2e, light-density (6) %.2e, voxel light (4) %.2e\n",
-              100 * (1 - without_sum / with_sum), projection, light, voxel);
+              "projection (4) %.2e, light-density (6) %.2e, voxel light (4) %.2e, pre-integrated %.2e\n",
+              100 * (1 - without_sum / with_sum), projection, light, voxel, pre);
+  EXPECT_LT(pre, 1e-2);
   EXPECT_LT(projection, 1e-2);
   EXPECT_LT(light, 1e-2);
   EXPECT_LT(voxel, 1e-2);

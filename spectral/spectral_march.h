@@ -22,6 +22,10 @@
 //   LightBasis: s_T e^(-kappa D) on the light-density basis over (D, T): N
 //               coefficients per pair, one set of accumulators for all stars
 //               (Algorithm 5).
+//   Preintegrated: the whole integral S_f kappa s e^(-kappa D) tabulated per
+//               star and filter over D (pre-integration, the report's section
+//               4.4 as we read it): one lookup per pair and filter, no basis;
+//               a filter change rebuilds the tables and re-runs the march.
 //   VoxelLight: a per-view pre-pass sums every star's light per voxel, so the
 //               march's cost per voxel does not grow with the stars. The pair's
 //               integral splits as integral S_f kappa s e^(-kappa D_star)
@@ -51,7 +55,7 @@
 
 namespace nebula::spectral {
 
-enum class SpectralMethod { Double, Analytic, Projection, LightBasis, VoxelLight };
+enum class SpectralMethod { Double, Analytic, Projection, LightBasis, VoxelLight, Preintegrated };
 
 constexpr int kMaxAccumulators = 64;  // per ray: registers on the GPU
 constexpr int kMaxBasis = 16;
@@ -101,6 +105,10 @@ struct SpectralSceneView {
   int n_basis = 0, n_depth = 0, n_temperature = 1;
   float depth_step = 1;
   const float* coeff = nullptr;
+  // Preintegrated (n_acc = filters F): star_coeff[star][p][d][f] = the integral over
+  // lambda of S_f kappa (kappa - kappa_c)^p s e^(-kappa D_d) (VoxelLight's Q with the
+  // one element phi = 1: n_basis 1); emission_coeff[component][d][f] that of S_f phi
+  // e^(-kappa D_d) for a continuum.
   // VoxelLight (n_acc = filters F): star_coeff[star][d][f][j] = Q_fj(star, D_d) on the
   // coeff table's depths; voxel_light[cell][4][F N] the pre-pass' U at the voxel's
   // centre and its x, y, z derivatives; near_stars[cell] bit k: star k's pair is
@@ -334,8 +342,11 @@ NEBULA_HD void add_emission(const SpectralSceneView& s, size_t cell, float tau_v
       if (!(x < float(s.n_depth - 1))) continue;  // beyond the table: below the transmittance cut
       const int d0 = int(x);
       const float fd = x - float(d0);
-      const int N = s.n_basis;
-      const float* c0 = s.emission_coeff + size_t(d0) * N;
+      // Preintegrated: the component's own table, one number per filter; else c_j(D), one per element.
+      const int N = kMethod == SpectralMethod::Preintegrated ? s.n_acc : s.n_basis;
+      const float* c0 = s.emission_coeff +
+                        (kMethod == SpectralMethod::Preintegrated ? size_t(c) * s.n_depth * N : size_t(0)) +
+                        size_t(d0) * N;
       for (int j = 0; j < N; ++j) out[j] += w * (c0[j] + fd * (c0[N + j] - c0[j]));
     }
   }
@@ -401,6 +412,19 @@ NEBULA_HD void add_pair(const SpectralSceneView& s, int star, const PairWeights&
     }
     case SpectralMethod::VoxelLight:
       break;  // summed per voxel ahead of the march (voxel_light)
+    case SpectralMethod::Preintegrated: {
+      const float x = D / s.depth_step;
+      if (!(x < float(s.n_depth - 1))) break;  // beyond the table: below the transmittance cut
+      const int d0 = int(x);
+      const float fd = x - float(d0);
+      const int F = s.n_acc;
+      for_each_index<kMaxTableNodes>(w.n, [&](int p) {
+        const float* q = s.star_coeff + ((size_t(star) * s.n_powers + p) * s.n_depth + d0) * F;
+        const float wp = w.b[p];
+        for_each_index<Acc::kCols>(F, [&](int f) { acc(0, f) += wp * (q[f] + fd * (q[F + f] - q[f])); });
+      });
+      break;
+    }
     case SpectralMethod::Projection:
     case SpectralMethod::LightBasis: {
       const float x = D / s.depth_step;
@@ -823,6 +847,9 @@ void dispatch_method(SpectralMethod m, F&& f) {
     case SpectralMethod::Projection: f(std::integral_constant<SpectralMethod, SpectralMethod::Projection>()); break;
     case SpectralMethod::LightBasis: f(std::integral_constant<SpectralMethod, SpectralMethod::LightBasis>()); break;
     case SpectralMethod::VoxelLight: f(std::integral_constant<SpectralMethod, SpectralMethod::VoxelLight>()); break;
+    case SpectralMethod::Preintegrated:
+      f(std::integral_constant<SpectralMethod, SpectralMethod::Preintegrated>());
+      break;
   }
 }
 

@@ -239,6 +239,16 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
         }
       break;
     }
+    case SpectralMethod::Preintegrated: {
+      // The one element phi = 1: the star tables (build_star_tables) are then the whole
+      // integral per star and filter over D, on the depths the basis methods tabulate.
+      m.basis = GreedyBasis{};
+      m.basis.phi.push_back(std::vector<double>(m.grid.lambda.size(), 1.0));
+      m.settings.basis = 1;
+      m.depth_step = float(m.max_depth / (settings.depth_nodes - 1));
+      set_filters(m, filters);  // the star and emission tables
+      return m;
+    }
     case SpectralMethod::Projection:
     case SpectralMethod::LightBasis:
     case SpectralMethod::VoxelLight: {
@@ -330,7 +340,8 @@ namespace {
 // plane, a continuum one per filter (Double, Analytic) or per basis element.
 void build_emission(SpectralModel& m) {
   const SpectralMethod method = m.settings.method;
-  const bool per_filter = method == SpectralMethod::Double || method == SpectralMethod::Analytic;
+  const bool per_filter = method == SpectralMethod::Double || method == SpectralMethod::Analytic ||
+                          method == SpectralMethod::Preintegrated;
   const int F = int(m.filters.size()), n = m.basis.size();
   m.emission_plane.clear();
   m.n_emission_planes = 0;
@@ -373,6 +384,25 @@ void build_emission(SpectralModel& m) {
         m.emission_breaks.insert(m.emission_breaks.end(), p.breaks.begin(), p.breaks.end());
         m.emission_coefficients.insert(m.emission_coefficients.end(), p.coefficients.begin(), p.coefficients.end());
       }
+  } else if (method == SpectralMethod::Preintegrated) {
+    // integral S_f phi e^(-kappa D) per component, depth and filter (zeros for a line).
+    const int D = m.settings.depth_nodes;
+    m.emission_coeff.assign(m.emission.size() * size_t(D) * F, 0.0f);
+    std::vector<double> e(m.grid.lambda.size());
+    for (int d = 0; d < D; ++d) {
+      for (size_t i = 0; i < e.size(); ++i) e[i] = std::exp(-m.kappa_grid[i] * d * double(m.depth_step));
+      for (size_t c = 0; c < m.emission.size(); ++c) {
+        if (m.emission[c].line_um > 0) continue;
+        for (int f = 0; f < F; ++f) {
+          double sum = 0.0;
+          for (size_t i = 0; i < e.size(); ++i) {
+            const double l = m.grid.lambda[i];
+            sum += m.grid.weight[i] * m.filters[f](l) * m.emission[c].phi(l) * e[i];
+          }
+          m.emission_coeff[(c * D + d) * F + f] = float(sum);
+        }
+      }
+    }
   } else if (method == SpectralMethod::LightBasis) {
     // e^(-kappa D) on the basis (the other basis methods' first coefficient block is that table).
     std::vector<double> f(m.grid.lambda.size());
@@ -390,8 +420,9 @@ void build_emission(SpectralModel& m) {
 void add_emission_resolve(SpectralModel& m) {
   if (m.n_emission_planes == 0) return;
   const int F = int(m.filters.size()), A = m.n_acc, W = m.planes();
-  const bool per_filter =
-      m.settings.method == SpectralMethod::Double || m.settings.method == SpectralMethod::Analytic;
+  const bool per_filter = m.settings.method == SpectralMethod::Double ||
+                          m.settings.method == SpectralMethod::Analytic ||
+                          m.settings.method == SpectralMethod::Preintegrated;
   std::vector<float> r(size_t(F) * W, 0.0f);
   for (int f = 0; f < F; ++f)
     for (int k = 0; k < A; ++k) r[size_t(f) * W + k] = m.resolve[size_t(f) * A + k];
@@ -460,8 +491,10 @@ void build_star_tables(SpectralModel& m) {
 void set_filters(SpectralModel& m, const std::vector<std::pair<std::string, Passband>>& filters) {
   const bool light = m.settings.method == SpectralMethod::LightBasis;
   const bool voxel = m.settings.method == SpectralMethod::VoxelLight;
-  if (!light && !voxel && m.settings.method != SpectralMethod::Projection)
-    throw Error("spectral: filters change on a basis only (the projection, light-density or voxel-light method)");
+  const bool pre = m.settings.method == SpectralMethod::Preintegrated;
+  if (!light && !voxel && !pre && m.settings.method != SpectralMethod::Projection)
+    throw Error("spectral: filters change on a basis or tables only (the projection, light-density, voxel-light or "
+                "pre-integrated method)");
   m.filter_names.clear();
   m.filters.clear();
   m.fits.clear();
@@ -475,7 +508,8 @@ void set_filters(SpectralModel& m, const std::vector<std::pair<std::string, Pass
     m.filters.push_back(fit_passband(band, 2e-3, &r));
     m.fits.push_back(r);
   }
-  if (voxel) {
+  if (voxel || pre) {
+    if (pre) build_emission(m);  // its continua's tables hold the filters
     build_star_tables(m);
     add_emission_resolve(m);
     return;

@@ -53,7 +53,7 @@ TEST(SpectralModel, MethodsAgainstQuadrature) {
   SpectralSettings s;
   uint64_t counter = 0;
   for (SpectralMethod method : {SpectralMethod::Double, SpectralMethod::Analytic, SpectralMethod::Projection,
-                                SpectralMethod::LightBasis}) {
+                                SpectralMethod::LightBasis, SpectralMethod::Preintegrated}) {
     s.method = method;
     s.wavelengths = 2000;
     const SpectralModel m = build_spectral_model(f, stars, s);

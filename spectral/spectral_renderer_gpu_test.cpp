@@ -34,7 +34,8 @@ TEST(SpectralRendererGpu, AgreesWithTheCpu) {
   for (const char* n : {"B", "V", "R"}) f.push_back({n, load_filter(n)});
   const ScatteringTable table = nebula::testing::make_test_table(5.0, 501, AngularBinning::UniformTheta, 90, 0.6);
   for (SpectralMethod method : {SpectralMethod::Double, SpectralMethod::Analytic, SpectralMethod::Projection,
-                                SpectralMethod::LightBasis, SpectralMethod::VoxelLight})
+                                SpectralMethod::LightBasis, SpectralMethod::VoxelLight,
+                                SpectralMethod::Preintegrated})
     for (int nodes : {0, 3}) {  // the thin limit; the table at 3 attenuations (docs/spectral.md, "Tables")
       SpectralSettings s;
       s.method = method;
@@ -59,7 +60,8 @@ TEST(SpectralRendererGpu, LightBetweenVoxelsAgreesWithTheCpu) {
   for (const char* n : {"B", "V", "R"}) f.push_back({n, load_filter(n)});
   const ScatteringTable table = nebula::testing::make_test_table(5.0, 501, AngularBinning::UniformTheta, 90, 0.6);
   for (SpectralMethod method : {SpectralMethod::Double, SpectralMethod::Analytic, SpectralMethod::Projection,
-                                SpectralMethod::LightBasis, SpectralMethod::VoxelLight}) {
+                                SpectralMethod::LightBasis, SpectralMethod::VoxelLight,
+                                SpectralMethod::Preintegrated}) {
     SpectralSettings s;
     s.method = method;
     s.table_nodes = 3;
@@ -86,7 +88,8 @@ TEST(SpectralRendererGpu, EmissionAgreesWithTheCpu) {
   std::vector<std::pair<std::string, Passband>> f;
   for (const char* n : {"B", "V", "R"}) f.push_back({n, load_filter(n)});
   for (SpectralMethod method : {SpectralMethod::Double, SpectralMethod::Analytic, SpectralMethod::Projection,
-                                SpectralMethod::LightBasis, SpectralMethod::VoxelLight}) {
+                                SpectralMethod::LightBasis, SpectralMethod::VoxelLight,
+                                SpectralMethod::Preintegrated}) {
     SpectralSettings s;
     s.method = method;
     s.attenuation = method == SpectralMethod::Analytic ? Attenuation::Inverse : Attenuation::Law;

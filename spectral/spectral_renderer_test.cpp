@@ -47,7 +47,8 @@ TEST(SpectralRenderer, ThinDustIsTheFilteredBlackBody) {
   double peak = 0;
   for (float v : ref.pixels) peak = std::max(peak, double(v));
   EXPECT_GT(peak, 0.0);
-  for (SpectralMethod m : {SpectralMethod::Analytic, SpectralMethod::Projection, SpectralMethod::LightBasis}) {
+  for (SpectralMethod m : {SpectralMethod::Analytic, SpectralMethod::Projection, SpectralMethod::LightBasis,
+                           SpectralMethod::Preintegrated}) {
     s.method = m;
     const double err = worst_relative(render_with(scene, build_spectral_model(filters({"B", "V", "R"}), {{41400}}, s)), ref);
     std::printf("  method %d: largest pixel error %.2e against the double integral (M = 4000)\n", int(m), err);
@@ -154,6 +155,23 @@ TEST(SpectralRenderer, FilterChangeNeedsNoNewMarch) {
   EXPECT_THROW(set_filters(m, filters({"sdss_z"})), Error);  // reaches 1.11 um, past the basis range
 }
 
+// Pre-integration holds the filters in its tables: a filter change rebuilds
+// them (no bake) and the march runs again, giving the fresh model's image.
+TEST(SpectralRenderer, PreintegratedFilterChangeRebuildsItsTables) {
+  auto scene = testing::noise_scene(12, 0.5f, {{0.1f, 0.2f, -0.1f}, {-0.3f, 0.0f, 0.2f}}, 20, 20);
+  SpectralSettings s;
+  s.method = SpectralMethod::Preintegrated;
+  s.lo_um = 0.3;
+  s.hi_um = 1.0;
+  std::vector<SpectralStar> stars{{41400}, {3850}};
+  SpectralModel m = build_spectral_model(filters({"B", "V"}), stars, s);
+  set_filters(m, filters({"sdss_r", "F606W"}));
+  const Image changed = render_with(scene, m);
+  const Image fresh = render_with(scene, build_spectral_model(filters({"sdss_r", "F606W"}), stars, s));
+  ASSERT_EQ(changed.bands, fresh.bands);
+  for (size_t i = 0; i < fresh.pixels.size(); ++i) EXPECT_EQ(changed.pixels[i], fresh.pixels[i]);
+}
+
 
 // A table that is exactly the thin limit, P = tau_sct p_HG (isotropic, so that
 // the lookup's interpolation in angle is exact too): every method at every
@@ -168,7 +186,7 @@ TEST(SpectralRendererTables, AThinTableGivesTheThinImage) {
   nebula::testing::finish_table(thin);
   auto scene = testing::noise_scene(12, 0.8f, {{0.1f, 0.2f, -0.1f}, {-0.3f, 0.0f, 0.2f}}, 20, 16);
   for (SpectralMethod method : {SpectralMethod::Double, SpectralMethod::Analytic, SpectralMethod::Projection,
-                                SpectralMethod::LightBasis, SpectralMethod::VoxelLight}) {
+                                SpectralMethod::LightBasis, SpectralMethod::VoxelLight, SpectralMethod::Preintegrated}) {
     SpectralSettings s;
     s.method = method;
     s.wavelengths = 40;
@@ -213,7 +231,8 @@ TEST(SpectralRendererTables, NodesAgainstTheDoubleIntegral) {
   const double change = worst_relative(thin, ref);
   std::printf("  the table against the thin limit: largest pixel change %.3f\n", change);
   EXPECT_GT(change, 0.1);
-  for (SpectralMethod method : {SpectralMethod::Projection, SpectralMethod::LightBasis, SpectralMethod::VoxelLight}) {
+  for (SpectralMethod method : {SpectralMethod::Projection, SpectralMethod::LightBasis, SpectralMethod::VoxelLight,
+                                SpectralMethod::Preintegrated}) {
     s.method = method;
     s.basis = method == SpectralMethod::LightBasis ? 8 : 6;
     s.depth_nodes = 1024;
@@ -306,7 +325,7 @@ TEST(SpectralRendererTables, ADenseVoxelStaysFinite) {
   scene.grid.tau_v[scene.grid.shape.index(4, 4, 4)] = 1000.0f;
   scene.bake = bake_star_depths_cpu(scene.grid, scene.star_positions);
   for (SpectralMethod method : {SpectralMethod::Double, SpectralMethod::Analytic, SpectralMethod::Projection,
-                                SpectralMethod::LightBasis, SpectralMethod::VoxelLight}) {
+                                SpectralMethod::LightBasis, SpectralMethod::VoxelLight, SpectralMethod::Preintegrated}) {
     SpectralSettings s;
     s.method = method;
     s.table_nodes = 3;
