@@ -108,9 +108,15 @@ void print_spectral(const RunReport& r) {
                 (unsigned long long)t.photons_per_row);
   }
   if (s.table_nodes > 0) {
-    std::printf("  scattering per voxel through its table (multiple scattering inside it), read at kappa =");
+    std::printf(r.tables.empty() ? "  single scattering per voxel (thin-voxel HG, spectral.tables = false), taken at kappa ="
+                                 : "  scattering per voxel through its table (multiple scattering inside it), read at kappa =");
     for (double k : s.node_kappa) std::printf(" %.3g", k);
     std::printf(" and interpolated in kappa between\n");
+    if (!s.node_albedo.empty()) {
+      std::printf("  albedo and g varying with wavelength ([spectral.dust]), at those attenuations:");
+      for (size_t m = 0; m < s.node_albedo.size(); ++m) std::printf(" a %.3g g %.3g;", s.node_albedo[m], s.node_g[m]);
+      std::printf(" each node %s\n", r.tables.empty() ? "in the thin-voxel limit" : "through its own table");
+    }
     if (r.diffuse.done)
       std::printf("  light between voxels: the band renderer's diffuse field of each star alone (%zu field(s)), baked "
                   "at those attenuations (one band each, the star's light at its wavelength), per-view passes %.3g s; "

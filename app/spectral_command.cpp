@@ -260,7 +260,7 @@ void add_spectral_bench(CLI::App* bench) {
       double view = 0;
       const auto start = std::chrono::steady_clock::now();
       spectral::SpectralDiffuseLight light =
-          spectral_diffuse_light(*loaded, m, *table, bake, b.camera, options, report, &view);
+          spectral_diffuse_light(*loaded, m, std::vector<const ScatteringTable*>(m.node_kappa.size(), &*table), bake, b.camera, options, report, &view);
       std::printf("light between voxels at kappa =");
       for (double k : m.node_kappa) std::printf(" %.3g", k);
       std::printf(": %zu star(s) x %zu photons per node, fields %.3f s (photon passes %.3f s), per-view passes %.4f s "

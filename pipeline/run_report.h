@@ -113,6 +113,7 @@ struct SpectralReport {
   std::vector<SpectralFilterReport> filters;
   int table_nodes = 0;            // attenuations the voxels' table is read at; 0: the thin limit (no table)
   std::vector<double> node_kappa; // their kappa = tau / tau_V
+  std::vector<double> node_albedo, node_g;  // albedo and g varying with wavelength: each node's ([spectral.dust])
   double model_seconds = 0;       // fits, basis and tables (host)
   double resolve_seconds = 0;     // accumulators to one plane per filter
   double diffuse_view_seconds = 0;  // light between voxels: the field's per-view pass and the voxels' terms

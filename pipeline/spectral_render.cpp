@@ -37,7 +37,8 @@ spectral::SpectralMethod method_of(const std::string& name) {
 // table, the star's power L s(lambda_m) at a wavelength where kappa(lambda_m) =
 // kappa_m (spectral_scene.h).
 spectral::SpectralDiffuseLight spectral_diffuse_light(const Scene& scene, const spectral::SpectralModel& model,
-                                                      const ScatteringTable& table, BakeResult& bake,
+                                                      const std::vector<const ScatteringTable*>& tables,
+                                                      BakeResult& bake,
                                                       const Camera& camera, const RenderOptions& o,
                                                       RunReport& report, double* view_seconds) {
   const int n = int(model.node_kappa.size());
@@ -50,11 +51,12 @@ spectral::SpectralDiffuseLight spectral_diffuse_light(const Scene& scene, const 
     std::snprintf(name, sizeof name, "kappa %.3g", model.node_kappa[size_t(m)]);
     b.name = name;
     b.extinction_ratio = float(model.node_kappa[size_t(m)]);
-    b.albedo = float(scene.dust.albedo.front());
-    b.g = float(scene.dust.g.front());
-    b.table = &table;
+    // The node's own albedo and g when they vary with wavelength, its table for them.
+    b.albedo = float(model.varying() ? model.node_albedo[size_t(m)] : scene.dust.albedo.front());
+    b.g = float(model.varying() ? model.node_g[size_t(m)] : scene.dust.g.front());
+    b.table = tables[size_t(m)];
     static_cast<Band&>(render_bands[size_t(m)]) = b;
-    render_bands[size_t(m)].table = &table;
+    render_bands[size_t(m)].table = b.table;
     lambda[size_t(m)] = model.wavelength_of_kappa(model.node_kappa[size_t(m)]);
   }
   DiffuseBakeOptions options = diffuse_options(scene);
@@ -124,7 +126,12 @@ spectral::SpectralSettings spectral_settings(const Scene& scene) {
   s.near_voxels = p.near_voxels;
   s.lo_um = p.range_lo_um;
   s.hi_um = p.range_hi_um;
-  s.table_nodes = p.tables ? p.table_nodes : 0;
+  s.table_nodes = p.tables || !p.dust_nm.empty() ? p.table_nodes : 0;  // a curve: the nodes, with tables or thin
+  for (size_t i = 0; i < p.dust_nm.size(); ++i) {  // a curve left out holds the dust's constant
+    s.curve_um.push_back(p.dust_nm[i] / 1000.0);
+    s.curve_albedo.push_back(p.dust_albedo.empty() ? scene.dust.albedo.front() : p.dust_albedo[i]);
+    s.curve_g.push_back(p.dust_g.empty() ? scene.dust.g.front() : p.dust_g[i]);
+  }
   return s;
 }
 
@@ -140,7 +147,8 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
   // The voxels' scattering table for the dust's (albedo, g): the scene's file or
   // the cached one (generated on first use), as the band renderer takes it.
   std::shared_ptr<const ScatteringTable> table;
-  if (scene.spectral->tables) {
+  const bool varying = !scene.spectral->dust_nm.empty();  // its node tables come with the model, below
+  if (scene.spectral->tables && !varying) {
     BandTables tables = resolve_tables(scene, {o.backend, o.table_photons, o.progress});
     for (const auto& t : tables.per_band)
       if (t) {
@@ -160,9 +168,7 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
   if (scene.multiple_scattering == MultipleScattering::Pyramid)
     throw Error(scene.path + ": render.multiple_scattering: the spectral renderer takes the light between voxels "
                              "from the diffuse field (\"diffuse\", the default) or none (\"none\"); no pyramid");
-  // Light between voxels: the band renderer's diffuse field baked at the nodes (needs the tables and a star).
-  const bool diffuse = scene.multiple_scattering == MultipleScattering::Diffuse && table && settings.table_nodes >= 1 &&
-                       !scene.stars.empty();
+  const bool tables = scene.spectral->tables;
   std::vector<spectral::SpectralEmission> emission;
   for (const SpectralEmissionSpec& e : scene.spectral->emission)
     emission.push_back({e.line_nm / 1000.0, e.continuum, e.lo_nm / 1000.0, e.hi_nm / 1000.0});
@@ -186,8 +192,34 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
   sr.basis_error = model.basis.error.empty() ? 0.0 : model.basis.error.back();
   sr.accumulators = model.planes();
   for (const spectral::SpectralEmission& e : model.emission) ++(e.line_um > 0 ? sr.emission_lines : sr.emission_continua);
-  sr.table_nodes = table ? settings.table_nodes : 0;
-  sr.node_kappa = table ? model.node_kappa : std::vector<double>{};
+  // With albedo and g varying: a table per node for its (a, g), from the cache or generated.
+  std::vector<std::shared_ptr<const ScatteringTable>> node_tables;
+  if (varying && tables)
+    for (size_t m = 0; m < model.node_kappa.size(); ++m) {
+      TabulateParams p;
+      p.albedo = model.node_albedo[m];
+      p.g = model.node_g[m];
+      p.binning = AngularBinning::UniformTheta;
+      p.photons_per_row = o.table_photons;
+      const auto t0 = std::chrono::steady_clock::now();
+      TableReport r{p.albedo, p.g, {"node " + std::to_string(m)}, TableOrigin::Cache, "", 0, ""};
+      node_tables.push_back(
+          std::make_shared<const ScatteringTable>(cached_table(p, o.backend, o.progress, &r.origin, &r.path, &r.warning)));
+      r.seconds = seconds_since(t0);
+      r.noise = node_tables.back()->median_relative_error();
+      r.photons_per_row = node_tables.back()->photons_per_row;
+      report.tables.push_back(r);
+    }
+  std::vector<const ScatteringTable*> read_tables;  // what each node reads (the one table, or its own)
+  for (size_t m = 0; m < model.node_kappa.size(); ++m)
+    read_tables.push_back(varying ? (node_tables.empty() ? nullptr : node_tables[m].get()) : table.get());
+  // Light between voxels: the band renderer's diffuse field baked at the nodes (needs the tables and a star).
+  const bool diffuse = scene.multiple_scattering == MultipleScattering::Diffuse && settings.table_nodes >= 1 &&
+                       !scene.stars.empty() && (varying ? !node_tables.empty() : table != nullptr);
+  sr.table_nodes = tables || varying ? settings.table_nodes : 0;
+  sr.node_kappa = tables || varying ? model.node_kappa : std::vector<double>{};
+  sr.node_albedo = model.node_albedo;
+  sr.node_g = model.node_g;
   for (size_t b = 0; b < filters.size(); ++b)
     sr.filters.push_back({filters[b].first, filters[b].second.wavelength_nm.front(),
                           filters[b].second.wavelength_nm.back(), pivot_wavelength_nm(filters[b].second),
@@ -212,6 +244,7 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
   in.albedo = float(scene.dust.albedo.front());
   in.g = float(scene.dust.g.front());
   in.table = table.get();
+  for (const auto& t : node_tables) in.node_tables.push_back(t.get());
   for (size_t c = 0; c < emission.size(); ++c) {
     const auto& grids = scene.spectral->emission_grids;  // scale applied; none: the voxel's tau_V times scale
     const std::vector<float>* grid = c < grids.size() && !grids[c].empty() ? &grids[c] : nullptr;
@@ -220,7 +253,7 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
   in.camera = make_camera(scene.camera);
   spectral::SpectralDiffuseLight diffuse_light;
   if (diffuse) {
-    diffuse_light = spectral_diffuse_light(scene, model, *table, bake, in.camera, o, report, &sr.diffuse_view_seconds);
+    diffuse_light = spectral_diffuse_light(scene, model, read_tables, bake, in.camera, o, report, &sr.diffuse_view_seconds);
     in.diffuse = &diffuse_light;
   }
   double march_seconds = 0;
@@ -241,7 +274,7 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
       {"multiple_scattering",
        diffuse ? "inside voxels (tables) and between them (the diffuse field at " + std::to_string(settings.table_nodes) +
                      " attenuations; spectral renderer)"
-       : table ? "inside voxels (tables), none between them (spectral renderer)"
+       : tables ? "inside voxels (tables), none between them (spectral renderer)"
                : "none (spectral renderer: thin-voxel single scattering)"});
   out.metadata.entries.push_back({"spec_nodes", sr.table_nodes});
   out.metadata.entries.push_back({"spec_emission", int(emission.size())});

@@ -69,7 +69,7 @@ TEST_F(SpectralSceneGpu, DeviceLightMarchedByBothBackends) {
   o.backend = Backend::Cuda;
   RunReport report;
   double view = 0;
-  const spectral::SpectralDiffuseLight light = spectral_diffuse_light(s, m, table, bake, in.camera, o, report, &view);
+  const spectral::SpectralDiffuseLight light = spectral_diffuse_light(s, m, {&table, &table, &table}, bake, in.camera, o, report, &view);
   ASSERT_TRUE(light.on_device());
   in.diffuse = &light;
   const Image gpu = spectral::render_spectral(in, Backend::Cuda), cpu = spectral::render_spectral(in, Backend::Cpu);

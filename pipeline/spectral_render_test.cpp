@@ -277,6 +277,62 @@ TEST_F(SpectralScene, LightBetweenVoxelsAddsStarByStar) {
   EXPECT_LT(worst, 1e-5 * peak);
 }
 
+// Albedo and g varying with wavelength ([spectral.dust]): each table node
+// reads a table for its own (a, g), generated and cached like the band
+// renderer's. A curve that is constant at the dust's a and g names the same
+// cached table at every node, so the image is the constant dust's (light
+// between voxels included) to float rounding; a varying one reports each
+// node's (a, g) and table and changes the image.
+TEST_F(SpectralScene, AlbedoAndGVaryingWithWavelength) {
+  const auto curve_scene = [&](const std::string& dust, const std::vector<std::string>& overrides = {}) {
+    const std::string text = "bands = [\"B\", \"V\", \"R\"]\n[density]\nprocedural = { n = 16, size_pc = 2.0 }\n"
+                             "[[stars]]\nluminosity_lsun = 2e5\nclass = \"O5V\"\n"
+                             "[camera]\nposition = [1, -2.5, 1]\nlook_at = [1, 1, 1]\nwidth = 32\nheight = 24\n"
+                             "[render]\ndiffuse_photons = 32768\n[spectral]\nmethod = \"projection\"\nbasis = 4\n" +
+                             dust;
+    return load_scene(write_text("curve.toml", text), overrides);
+  };
+  const RenderOutput constant = render_scene(curve_scene(""), options());
+  const RenderOutput flat = render_scene(
+      curve_scene("[spectral.dust]\nwavelength_nm = [400, 800]\nalbedo = [0.6, 0.6]\ng = [0.6, 0.6]\n"), options());
+  double peak = 0, worst = 0;
+  for (size_t i = 0; i < constant.image.pixels.size(); ++i) {
+    peak = std::max(peak, double(constant.image.pixels[i]));
+    worst = std::max(worst, std::fabs(double(flat.image.pixels[i]) - constant.image.pixels[i]));
+  }
+  EXPECT_GT(peak, 0.0);
+  EXPECT_LT(worst, 1e-5 * peak);
+  const RenderOutput varying = render_scene(
+      curve_scene("[spectral.dust]\nwavelength_nm = [350, 550, 900]\nalbedo = [0.4, 0.6, 0.7]\ng = [0.7, 0.6, 0.5]\n"),
+      options());
+  ASSERT_TRUE(varying.report.spectral);
+  const SpectralReport& r = *varying.report.spectral;
+  ASSERT_EQ(r.node_albedo.size(), 3u);
+  EXPECT_GT(r.node_albedo.front(), r.node_albedo.back());  // the reddest node first: the largest albedo
+  EXPECT_LT(r.node_g.front(), r.node_g.back());
+  EXPECT_EQ(varying.report.tables.size(), 3u);
+  EXPECT_TRUE(varying.report.diffuse.done);
+  double change = 0;
+  for (size_t i = 0; i < constant.image.pixels.size(); ++i)
+    change = std::max(change, std::fabs(double(varying.image.pixels[i]) - constant.image.pixels[i]) / peak);
+  EXPECT_GT(change, 0.01);
+  // Bad curves, and what a curve cannot go with, name the key.
+  testing::expect_error([&] { curve_scene("[spectral.dust]\nalbedo = [0.5]\n"); },
+                        {"curve.toml", "spectral.dust.wavelength_nm", "required"});
+  testing::expect_error([&] { curve_scene("[spectral.dust]\nwavelength_nm = [400, 800]\nalbedo = [0.5]\n"); },
+                        {"curve.toml", "spectral.dust.albedo", "1 values for 2 wavelengths"});
+  testing::expect_error(
+      [&] { render_scene(curve_scene("[spectral.dust]\nwavelength_nm = [800, 400]\ng = [0.5, 0.6]\n"), options()); },
+      {"curve.toml", "spectral.dust.wavelength_nm", "increasing"});
+  testing::expect_error(
+      [&] { render_scene(curve_scene("[spectral.dust]\nwavelength_nm = [400, 800]\ng = [0.5, 1.0]\n"), options()); },
+      {"curve.toml", "spectral.dust.g", "(-1, 1)"});
+  testing::expect_error([&] {
+    render_scene(curve_scene("[spectral.dust]\nwavelength_nm = [400, 800]\ng = [0.5, 0.6]\n",
+                             {"spectral.method=double"}), options());
+  }, {"curve.toml", "spectral.method", "tables = false"});
+}
+
 TEST_F(SpectralScene, BadSettingsNameTheKeyAndWriteNothing) {
   testing::expect_error([&] { scene("basis = 0\n"); }, {"scene.toml", "spectral.basis", "1..16"});
   testing::expect_error([&] { scene("table_nodes = 5\n"); }, {"scene.toml", "spectral.table_nodes", "1..4"});

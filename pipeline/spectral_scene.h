@@ -19,8 +19,11 @@ spectral::SpectralSettings spectral_settings(const Scene& scene);
 // and photons summed; noise and memory the first star's); *view_seconds gets
 // the per-view passes' time. The model needs table nodes, the scene a star;
 // the stars' depth bakes lend the passes their device copies (a CUDA bake's).
+// `tables`: what each table node reads (the dust's one table, or with albedo and
+// g varying with wavelength the node's own).
 spectral::SpectralDiffuseLight spectral_diffuse_light(const Scene& scene, const spectral::SpectralModel& model,
-                                                      const ScatteringTable& table, BakeResult& bake,
+                                                      const std::vector<const ScatteringTable*>& tables,
+                                                      BakeResult& bake,
                                                       const Camera& camera, const RenderOptions& o,
                                                       RunReport& report, double* view_seconds);
 

@@ -201,9 +201,27 @@ std::optional<SceneIssue> spectral_issue(const Scene& s) {
       return SceneIssue{key + ".scale", "is " + to_text(c.scale) + "; must be >= 0 and finite"};
   }
   if (!all_equal(s.dust.albedo))
-    return SceneIssue{"dust.albedo", "the spectral renderer takes one albedo for every wavelength; give one number"};
+    return SceneIssue{"dust.albedo", "the spectral renderer takes one albedo, or a curve over wavelength in "
+                                     "[spectral.dust]; give one number"};
   if (!all_equal(s.dust.g))
-    return SceneIssue{"dust.g", "the spectral renderer takes one g for every wavelength; give one number"};
+    return SceneIssue{"dust.g", "the spectral renderer takes one g, or a curve over wavelength in [spectral.dust]; "
+                                "give one number"};
+  for (size_t i = 0; i < p.dust_nm.size(); ++i)
+    if (!(std::isfinite(p.dust_nm[i]) && p.dust_nm[i] > 0 && (i == 0 || p.dust_nm[i] > p.dust_nm[i - 1])))
+      return SceneIssue{"spectral.dust.wavelength_nm", "must be positive wavelengths in nm, increasing"};
+  for (double a : p.dust_albedo)
+    if (!(a >= 0 && a <= 1)) return SceneIssue{"spectral.dust.albedo", "holds " + to_text(a) + "; must be in [0, 1]"};
+  for (double g : p.dust_g)
+    if (!(g > -1 && g < 1)) return SceneIssue{"spectral.dust.g", "holds " + to_text(g) + "; must be in (-1, 1)"};
+  if (!p.dust_nm.empty()) {
+    for (const std::string& f : s.dust.table_files)
+      if (!f.empty())
+        return SceneIssue{"dust.tables", "with [spectral.dust] every table node has its own albedo and g, so its "
+                                         "own table (generated and cached); name none"};
+    if (p.method == "double" && p.tables)
+      return SceneIssue{"spectral.method", "the double integral would need a table per wavelength for [spectral.dust]; "
+                                           "it takes the curves with spectral.tables = false (the thin-voxel limit)"};
+  }
   for (const std::string& f : s.dust.table_files) {
     if (!f.empty() && !p.tables)
       return SceneIssue{"dust.tables", "spectral.tables = false (the thin-voxel limit) reads no scattering table"};

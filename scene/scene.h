@@ -158,6 +158,10 @@ struct SpectralSpec {
   double range_lo_um = 0, range_hi_um = 0;  // the basis' wavelength range; 0: the bands' span
   bool tables = true;                 // the voxel's table P(a tau_V kappa, mu); false: the thin limit tau_sct p_HG
   int table_nodes = 3;                // attenuations kappa at which the table is read, 1..4
+  // [spectral.dust]: albedo and g at these wavelengths (nm, increasing; linear
+  // between, constant beyond); empty: dust.albedo and dust.g at every
+  // wavelength. A curve left out holds the dust's constant at every point.
+  std::vector<double> dust_nm, dust_albedo, dust_g;
   std::vector<SpectralEmissionSpec> emission;  // [[spectral.emission]]
   // One weight grid per component, scale applied (empty for tau_V weights).
   std::vector<std::vector<float>> emission_grids;

@@ -66,7 +66,8 @@ const std::initializer_list<std::string_view> kTopKeys = {"bands",  "density", "
                                                           "spectral", "animation", "display"};
 const std::initializer_list<std::string_view> kSpectralKeys = {
     "method", "basis", "wavelengths", "attenuation", "norm", "fit_depth", "max_depth", "range_um", "near_voxels",
-    "tables", "table_nodes", "emission"};
+    "tables", "table_nodes", "emission", "dust"};
+const std::initializer_list<std::string_view> kSpectralDustKeys = {"wavelength_nm", "albedo", "g"};
 const std::initializer_list<std::string_view> kSpectralEmissionKeys = {"line_nm", "continuum", "range_nm", "file",
                                                                        "dataset", "scale"};
 const std::initializer_list<std::string_view> kRenderKeys = {
@@ -409,6 +410,28 @@ std::optional<SpectralSpec> Parser::parse_spectral(const toml::table& root) cons
       fail("spectral.range_um", "must be an array of 2 numbers [lo, hi] in um");
     p.range_lo_um = number((*a)[0], "spectral.range_um[0]");
     p.range_hi_um = number((*a)[1], "spectral.range_um[1]");
+  }
+  if (const toml::node* v = t.get("dust")) {
+    const toml::table& d = table_at(*v, "spectral.dust");
+    known_keys(d, "spectral.dust", kSpectralDustKeys);
+    const auto numbers = [&](const char* name, std::vector<double>& out) {
+      const std::string key = std::string("spectral.dust.") + name;
+      const toml::node* n = d.get(name);
+      if (n == nullptr) return;
+      const toml::array* a = n->as_array();
+      if (a == nullptr || a->empty() || a->size() > 64) fail(key, "must be an array of 1 to 64 numbers");
+      for (size_t k = 0; k < a->size(); ++k) out.push_back(number((*a)[k], key + "[" + std::to_string(k) + "]"));
+    };
+    numbers("wavelength_nm", p.dust_nm);
+    numbers("albedo", p.dust_albedo);
+    numbers("g", p.dust_g);
+    if (p.dust_nm.empty()) fail("spectral.dust.wavelength_nm", "is required: the wavelengths of the albedo and g values");
+    if (p.dust_albedo.empty() && p.dust_g.empty()) fail("spectral.dust", "give albedo, g or both at wavelength_nm");
+    for (const auto& [name, values] : {std::pair<const char*, const std::vector<double>*>{"albedo", &p.dust_albedo},
+                                       std::pair<const char*, const std::vector<double>*>{"g", &p.dust_g}})
+      if (!values->empty() && values->size() != p.dust_nm.size())
+        fail(std::string("spectral.dust.") + name, std::to_string(values->size()) + " values for " +
+                                                       std::to_string(p.dust_nm.size()) + " wavelengths");
   }
   if (const toml::node* v = t.get("emission")) {
     const toml::array* a = v->as_array();

@@ -156,6 +156,17 @@ struct SpectralSceneView {
   // (diffuse_eye_depth). Null: none.
   const float* diffuse = nullptr;
   const float* eye_tau = nullptr;
+  // Albedo and g varying with wavelength (SpectralSettings::curve_*;
+  // docs/spectral.md): node m scatters with (node_albedo[m], node_g[m]) through
+  // its own table node_P[m] (the axes are `table`'s), or in the thin-voxel limit
+  // a kappa tau p_HG where there are no tables (node_P null); albedo and g above
+  // are then only the reference the pair's weight w is made with. Double (thin
+  // limit only) takes them at each wavelength: lambda_albedo[i], lambda_g[i].
+  bool varying = false;
+  float node_albedo[kMaxTableNodes] = {}, node_g[kMaxTableNodes] = {};
+  const float* node_P[kMaxTableNodes] = {};
+  const float* lambda_albedo = nullptr;
+  const float* lambda_g = nullptr;
 };
 
 // Henyey-Greenstein phase function per steradian.
@@ -173,6 +184,7 @@ struct PairWeights {
   float b[kMaxTableNodes];
   int n;
   float scale, tau_sct, u;  // tables: w / (a tau_V p_HG), a tau_V, the table's angle coordinate
+  float tau_v, mu;          // varying albedo and g: the double integral's thin limit per wavelength
 };
 NEBULA_HD PairWeights pair_weights(const SpectralSceneView& s, float w, float tau_v, float mu) {
   PairWeights p;
@@ -181,14 +193,25 @@ NEBULA_HD PairWeights pair_weights(const SpectralSceneView& s, float w, float ta
   p.scale = 0.0f;
   p.tau_sct = s.albedo * tau_v;
   p.u = 0.0f;
+  p.tau_v = tau_v;
+  p.mu = mu;
   if (s.n_nodes == 0) return p;
   const float thin = p.tau_sct * hg_phase(mu, s.g);
   p.scale = thin > 0.0f ? w / thin : 0.0f;
   p.u = s.table.angle_coordinate(mu);
   float node[kMaxTableNodes];
   NEBULA_UNROLL
-  for (int m = 0; m < kMaxTableNodes; ++m)
-    if (m < s.n_nodes) node[m] = p.scale * s.table.lookup_at(p.tau_sct * s.node_kappa[m], p.u) / s.node_kappa[m];
+  for (int m = 0; m < kMaxTableNodes; ++m) {
+    if (m >= s.n_nodes) break;
+    if (s.varying) {  // the node's own albedo, g and table (or the thin limit)
+      const float tau_sct = s.node_albedo[m] * tau_v * s.node_kappa[m];
+      TableView t = s.table;
+      t.P = s.node_P[m];
+      node[m] = p.scale * (t.P ? t.lookup_at(tau_sct, p.u) : tau_sct * hg_phase(mu, s.node_g[m])) / s.node_kappa[m];
+    } else {
+      node[m] = p.scale * s.table.lookup_at(p.tau_sct * s.node_kappa[m], p.u) / s.node_kappa[m];
+    }
+  }
   NEBULA_UNROLL
   for (int q = 0; q < kMaxTableNodes; ++q) {
     if (q >= s.n_nodes) break;
@@ -369,6 +392,13 @@ NEBULA_HD void add_pair(const SpectralSceneView& s, int star, const PairWeights&
           const float e = w.b[0] * expf(-s.kappa[i] * D);
           for_each_index<Acc::kCols>(s.n_acc, [&](int f) { acc(0, f) += q[f * s.n_lambda + i] * e; });
         }
+      } else if (s.varying) {
+        for (int i = 0; i < s.n_lambda; ++i) {
+          // The thin limit at this wavelength's own albedo and g: P / kappa = a tau p_HG.
+          const float e =
+              w.scale * s.lambda_albedo[i] * w.tau_v * hg_phase(w.mu, s.lambda_g[i]) * expf(-s.kappa[i] * D);
+          for_each_index<Acc::kCols>(s.n_acc, [&](int f) { acc(0, f) += q[f * s.n_lambda + i] * e; });
+        }
       } else {
         for (int i = 0; i < s.n_lambda; ++i) {
           // P at this wavelength's own scattering depth (q holds S kappa s dlambda).
@@ -470,7 +500,7 @@ NEBULA_HD void add_diffuse(const SpectralSceneView& s, int k, size_t cell, float
   const float* t = s.diffuse + (cell * s.n_stars + k) * size_t(n + 1);
   PairWeights w;
   w.n = n;
-  w.scale = w.tau_sct = w.u = 0.0f;
+  w.scale = w.tau_sct = w.u = w.tau_v = w.mu = 0.0f;
   const float scale = s.stars[k].power * fraction;
   NEBULA_UNROLL
   for (int p = 0; p < kMaxTableNodes; ++p) w.b[p] = p < n ? scale * t[p] : 0.0f;

@@ -121,6 +121,22 @@ double SpectralModel::kappa_at(double lambda) const {
   return extinction_ratio_at(lambda * 1000.0, settings.R_V, settings.law) / C_T;
 }
 
+namespace {
+// The curve's value at x: linear between its points, constant beyond them.
+double curve_at(const std::vector<double>& x, const std::vector<double>& y, double at) {
+  if (at <= x.front()) return y.front();
+  if (at >= x.back()) return y.back();
+  const size_t i = size_t(std::upper_bound(x.begin(), x.end(), at) - x.begin());
+  const double t = (at - x[i - 1]) / (x[i] - x[i - 1]);
+  return y[i - 1] + t * (y[i] - y[i - 1]);
+}
+}  // namespace
+
+double SpectralModel::albedo_at(double lambda) const {
+  return curve_at(settings.curve_um, settings.curve_albedo, lambda);
+}
+double SpectralModel::g_at(double lambda) const { return curve_at(settings.curve_um, settings.curve_g, lambda); }
+
 double SpectralModel::wavelength_of_kappa(double kappa) const {
   size_t best = 0;
   for (size_t i = 1; i < grid.lambda.size(); ++i)
@@ -163,6 +179,19 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
                 std::to_string(kMaxTableNodes) + " (0: the thin-voxel limit)");
   if (settings.method == SpectralMethod::Analytic && settings.attenuation != Attenuation::Inverse)
     throw Error("spectral: the analytic integral needs the attenuation C_T / lambda (attenuation = \"inverse\")");
+  if (!settings.curve_um.empty()) {
+    const size_t n = settings.curve_um.size();
+    bool ok = settings.curve_albedo.size() == n && settings.curve_g.size() == n;
+    for (size_t i = 0; ok && i < n; ++i) ok = settings.curve_um[i] > 0 && (i == 0 || settings.curve_um[i] > settings.curve_um[i - 1]);
+    for (double a : settings.curve_albedo) ok = ok && a >= 0 && a <= 1;
+    for (double g : settings.curve_g) ok = ok && g > -1 && g < 1;
+    if (!ok)
+      throw Error("spectral: the albedo and g curves need increasing positive wavelengths, as many values as "
+                  "wavelengths, albedos in [0, 1] and |g| < 1");
+    if (settings.table_nodes < 1)
+      throw Error("spectral: albedo and g varying with wavelength need table_nodes >= 1 (each node its own albedo "
+                  "and g)");
+  }
   SpectralModel m;
   m.settings = settings;
   m.n_stars = int(stars.size());
@@ -201,6 +230,13 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
   }
   m.max_eye_depth = float(kTransmittanceCut / kappa_min);
   set_table_nodes(m, settings.table_nodes, kappa_min, kappa_max);
+  if (m.varying()) {  // each node's (a, g) at a wavelength of its attenuation
+    for (double k : m.node_kappa) {
+      m.node_lambda.push_back(m.wavelength_of_kappa(k));
+      m.node_albedo.push_back(m.albedo_at(m.node_lambda.back()));
+      m.node_g.push_back(m.g_at(m.node_lambda.back()));
+    }
+  }
   m.max_depth = settings.max_depth > 0 ? settings.max_depth : kTransmittanceCut / kappa_min;
   m.fit_depth = settings.fit_depth > 0 ? settings.fit_depth : std::min(kFitDepth, m.max_depth);
   if (!(m.fit_depth <= m.max_depth))
@@ -217,6 +253,11 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
       const int M = settings.wavelengths;
       const double step = (m.hi_um - m.lo_um) / M;
       for (int i = 0; i < M; ++i) m.kappa.push_back(float(m.kappa_at(m.lo_um + (i + 0.5) * step)));
+      if (m.varying())
+        for (int i = 0; i < M; ++i) {
+          m.lambda_albedo.push_back(float(m.albedo_at(m.lo_um + (i + 0.5) * step)));
+          m.lambda_g.push_back(float(m.g_at(m.lo_um + (i + 0.5) * step)));
+        }
       for (int s = 0; s < S; ++s)
         for (int f = 0; f < F; ++f)
           for (int i = 0; i < M; ++i) {
@@ -552,6 +593,13 @@ SpectralSceneView view_of(const SpectralModel& m) {
   v.star_coeff = m.star_coeff.data();
   v.n_powers = m.n_powers;
   v.kappa_center = float(m.kappa_center);
+  v.varying = m.varying();
+  for (size_t i = 0; i < m.node_albedo.size(); ++i) {
+    v.node_albedo[i] = float(m.node_albedo[i]);
+    v.node_g[i] = float(m.node_g[i]);
+  }
+  v.lambda_albedo = m.lambda_albedo.empty() ? nullptr : m.lambda_albedo.data();
+  v.lambda_g = m.lambda_g.empty() ? nullptr : m.lambda_g.data();
   for (size_t i = 0; i < m.node_kappa.size(); ++i) v.node_kappa[i] = float(m.node_kappa[i]);
   const int K = int(m.node_kappa.size());
   for (int p = 0; p < K; ++p)

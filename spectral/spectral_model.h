@@ -62,6 +62,14 @@ struct SpectralSettings {
   // between them); 0: the thin-voxel limit only. The renderer uses a table only
   // when given one.
   int table_nodes = 0;
+  // Albedo and g varying with wavelength (docs/spectral.md, "Albedo and g with
+  // wavelength"): their values at curve_um (increasing; both curves as long),
+  // linear between and constant beyond; empty: the renderer's one albedo and g. With a curve every
+  // table node scatters with its own (a, g), through its own table when the
+  // renderer has tables (SpectralRenderInputs::node_tables), else the thin-voxel
+  // limit at that node; so table_nodes >= 1, and the double integral, which
+  // would need a table per wavelength, takes them in the thin limit only.
+  std::vector<double> curve_um, curve_albedo, curve_g;
 };
 
 struct SpectralStar {
@@ -116,6 +124,14 @@ struct SpectralModel {
   // over them does not cancel); n_powers blocks in coeff and star_coeff.
   std::vector<double> node_kappa, node_to_power;
   double kappa_center = 0;
+  // With the curves: each node's wavelength, albedo and g; the double integral's
+  // albedo and g at each of its wavelengths.
+  std::vector<double> node_lambda, node_albedo, node_g;
+  std::vector<float> lambda_albedo, lambda_g;
+  bool varying() const { return !settings.curve_um.empty(); }
+  // The curves at lambda (um).
+  double albedo_at(double lambda_um) const;
+  double g_at(double lambda_um) const;
   int n_powers = 1;
   // Emission: its planes follow the n_acc star planes (the resolve's columns
   // n_acc .. n_acc + n_emission_planes - 1; spectral_march.h, add_emission).

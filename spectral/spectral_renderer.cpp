@@ -29,7 +29,7 @@ void check(const SpectralRenderInputs& in) {
   if (const SpectralDiffuseLight* d = in.diffuse) {
     const SpectralModel& m = *in.model;
     const size_t n = size_t(m.settings.table_nodes), voxels = in.density->shape.count();
-    if (!in.table || n < 1)
+    if ((!in.table && in.node_tables.empty()) || n < 1)
       throw Error("spectral render: light between voxels needs the voxels' table (table_nodes >= 1)");
     const bool device = d->on_device();
     bool sizes = d->node_power.size() == in.lights.size() &&
@@ -46,14 +46,41 @@ void check(const SpectralRenderInputs& in) {
       throw Error("spectral render: the light between voxels is not one array per star and table node (" +
                   std::to_string(n) + ") of the density's shape");
   }
-  if (in.table && in.model->settings.table_nodes > 0 &&
+  if (in.model->varying()) {
+    const SpectralModel& m = *in.model;
+    if (!in.node_tables.empty() && in.node_tables.size() != m.node_kappa.size())
+      throw Error("spectral render: " + std::to_string(in.node_tables.size()) + " node tables for " +
+                  std::to_string(m.node_kappa.size()) + " table nodes");
+    for (size_t k = 0; k < in.node_tables.size(); ++k) {
+      const ScatteringTable* t = in.node_tables[k];
+      if (!t || std::fabs(t->albedo - m.node_albedo[k]) > 1e-6 || std::fabs(t->g - m.node_g[k]) > 1e-6)
+        throw Error("spectral render: table node " + std::to_string(k) + " needs a table for albedo " +
+                    to_text(m.node_albedo[k]) + ", g " + to_text(m.node_g[k]));
+      if (t->tau != in.node_tables[0]->tau || t->mu_edges != in.node_tables[0]->mu_edges)
+        throw Error("spectral render: the node tables have different axes");
+    }
+    if (in.diffuse && in.node_tables.empty())
+      throw Error("spectral render: light between voxels needs the node tables (their response)");
+    if (m.settings.method == SpectralMethod::Double && !in.node_tables.empty())
+      throw Error("spectral render: the double integral would need a table per wavelength for varying albedo and g; "
+                  "it takes them in the thin-voxel limit only (no node tables)");
+  } else if (in.table && in.model->settings.table_nodes > 0 &&
       (std::fabs(in.table->albedo - in.albedo) > 1e-6 || std::fabs(in.table->g - in.g) > 1e-6))
     throw Error("spectral render: the table is for albedo " + to_text(in.table->albedo) + ", g " +
                 to_text(in.table->g) + "; the dust has albedo " + to_text(in.albedo) + ", g " + to_text(in.g));
 }
 }  // namespace
 
-void set_table(SpectralSceneView& view, const SpectralRenderInputs& in, const float* P) {
+void set_table(SpectralSceneView& view, const SpectralRenderInputs& in, const float* P,
+               const std::vector<const float*>& node_P) {
+  if (in.model->varying()) {  // every node its own albedo and g: nodes even in the thin limit
+    view.n_nodes = in.model->settings.table_nodes;
+    if (in.node_tables.empty()) return;  // the thin limit at each node
+    view.table = nebula::view_of(*in.node_tables[0]);  // the axes
+    view.table.C = nullptr;
+    for (size_t k = 0; k < node_P.size(); ++k) view.node_P[k] = node_P[k];
+    return;
+  }
   if (!in.table || in.model->settings.table_nodes == 0) return;  // the thin limit
   view.table = nebula::view_of(*in.table);
   view.table.P = P;
@@ -126,7 +153,9 @@ Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds) {
   view.albedo = in.albedo;
   view.g = in.g;
   view.footprint = in.camera.footprint();
-  set_table(view, in, in.table ? in.table->P.data() : nullptr);
+  std::vector<const float*> node_P;
+  for (const ScatteringTable* t : in.node_tables) node_P.push_back(t->P.data());
+  set_table(view, in, in.table ? in.table->P.data() : nullptr, node_P);
   const auto start = std::chrono::steady_clock::now();  // the per-view work is timed with the march
   const DiffuseTerms diffuse = diffuse_terms(in, view);
   if (in.diffuse) {

@@ -61,6 +61,11 @@ struct SpectralRenderInputs {
   // table_nodes attenuations (docs/spectral.md, "Tables"); null, or a model
   // with table_nodes 0: the thin-voxel limit P = tau_sct p_HG.
   const ScatteringTable* table = nullptr;
+  // Albedo and g varying with wavelength (a model with curves): one table per
+  // table node, for that node's albedo and g (SpectralModel::node_albedo,
+  // node_g; `table` is then unused); none: the thin-voxel limit at each node.
+  // albedo and g above are the reference the pair weights are made with.
+  std::vector<const ScatteringTable*> node_tables;
   std::vector<SpectralEmissionWeight> emission;  // one per model->emission component
   // With a table and table nodes (the model's); null: none.
   const SpectralDiffuseLight* diffuse = nullptr;
@@ -92,7 +97,9 @@ DiffuseTerms diffuse_terms(const SpectralRenderInputs& in, const SpectralSceneVi
 void set_emission(SpectralSceneView& view, const SpectralRenderInputs& in, const std::vector<const float*>& grids);
 
 // The scene view's table fields for these inputs (both backends; `P` is the
-// table's values where they live, host or device).
-void set_table(SpectralSceneView& view, const SpectralRenderInputs& in, const float* P);
+// table's values where they live, host or device; with varying albedo and g,
+// node_P the node tables' values, where they live).
+void set_table(SpectralSceneView& view, const SpectralRenderInputs& in, const float* P,
+               const std::vector<const float*>& node_P = {});
 
 }  // namespace nebula::spectral

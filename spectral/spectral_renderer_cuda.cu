@@ -135,7 +135,9 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
   view.albedo = in.albedo;
   view.g = in.g;
   view.footprint = in.camera.footprint();
-  if (in.table) set_table(view, in, upload(floats, in.table->P));
+  std::vector<const float*> node_P;
+  for (const ScatteringTable* t : in.node_tables) node_P.push_back(upload(floats, t->P));
+  set_table(view, in, in.table ? upload(floats, in.table->P) : nullptr, node_P);
   // Light between voxels: the per-view arrays where they lie (a CUDA pass leaves them on the
   // device; host arrays are uploaded here), the terms made by a kernel timed with the march.
   const size_t cells = in.density->shape.count();
