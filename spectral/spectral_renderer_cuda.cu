@@ -166,6 +166,8 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
   DeviceArray<const float*> light_table(light_ptrs), peak_table(peak_ptrs);
   const DeviceArray<float> power(powers);
   view.kappa = upload(floats, m.kappa);
+  view.lambda_albedo = upload(floats, m.lambda_albedo);  // varying albedo and g: the double integral's
+  view.lambda_g = upload(floats, m.lambda_g);
   view.q = upload(floats, m.q);
   view.coeff = upload(floats, m.coeff);
   view.breaks = upload(doubles, m.breaks);
