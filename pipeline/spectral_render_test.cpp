@@ -16,6 +16,7 @@
 #include "scene/scene_file.h"
 #include "scene/test_files.h"
 #include "spectral/spectral_renderer.h"
+#include "spectral/spectral_test_scene.h"
 #include "tables/table_file.h"
 #include "tables/test_tables.h"
 
@@ -64,20 +65,7 @@ double number_entry(const ImageMetadata& m, const std::string& key) {
   return 0;
 }
 
-// Largest relative error over pixels above 1e-3 of the band's peak.
-double worst_relative(const Image& a, const Image& ref) {
-  double worst = 0;
-  const size_t plane = ref.plane_size();
-  for (size_t b = 0; b < ref.bands.size(); ++b) {
-    double peak = 0;
-    for (size_t i = 0; i < plane; ++i) peak = std::max(peak, double(ref.pixels[b * plane + i]));
-    for (size_t i = 0; i < plane; ++i) {
-      const double r = ref.pixels[b * plane + i];
-      if (r > 1e-3 * peak) worst = std::max(worst, std::fabs(a.pixels[b * plane + i] - r) / r);
-    }
-  }
-  return worst;
-}
+using spectral::testing::worst_relative_per_band;
 
 TEST_F(SpectralScene, OnePlanePerFilterWithItsPivot) {
   // Without the light between voxels, so that the inputs below are all there is (it has a test of its own).
@@ -138,14 +126,14 @@ TEST_F(SpectralScene, OnePlanePerFilterWithItsPivot) {
 // further from it than the goal.
 TEST_F(SpectralScene, FastMethodsAgainstTheDoubleIntegral) {
   const Image ref = render("method = \"double\"\nwavelengths = 400\n").image;
-  const double projection = worst_relative(render("basis = 4\n").image, ref);
-  const double light = worst_relative(render("method = \"light_density\"\nbasis = 6\n").image, ref);
+  const double projection = worst_relative_per_band(render("basis = 4\n").image, ref);
+  const double light = worst_relative_per_band(render("method = \"light_density\"\nbasis = 6\n").image, ref);
   const Image inverse_ref = render("method = \"double\"\nwavelengths = 400\nattenuation = \"inverse\"\n").image;
-  const double analytic = worst_relative(render("method = \"analytic\"\nattenuation = \"inverse\"\n").image, inverse_ref);
-  const double voxel = worst_relative(render("method = \"voxel_light\"\nbasis = 4\n").image, ref);
-  const double pre = worst_relative(render("method = \"preintegrated\"\n").image, ref);
+  const double analytic = worst_relative_per_band(render("method = \"analytic\"\nattenuation = \"inverse\"\n").image, inverse_ref);
+  const double voxel = worst_relative_per_band(render("method = \"voxel_light\"\nbasis = 4\n").image, ref);
+  const double pre = worst_relative_per_band(render("method = \"preintegrated\"\n").image, ref);
   const RenderOutput thin = render("basis = 4\ntables = false\n");
-  const double thin_error = worst_relative(thin.image, ref);
+  const double thin_error = worst_relative_per_band(thin.image, ref);
   std::printf("  largest pixel error against the double integral: projection (4) %.2e, light-density (6) %.2e, "
               "analytic %.2e, voxel light (4) %.2e, pre-integrated %.2e; the thin limit %.2e\n",
               projection, light, analytic, voxel, pre, thin_error);
@@ -179,7 +167,7 @@ TEST_F(SpectralScene, EmissionThroughTheFilters) {
   EXPECT_GT(ha_gain, 0.5 * ha_plain) << "the line must show in the H-alpha filter";
   EXPECT_GT(g_gain, 0.0);  // the continuum
   const Image ref = render("method = \"double\"\nwavelengths = 400\n" + glow).image;
-  const double err = worst_relative(lit.image, ref);
+  const double err = worst_relative_per_band(lit.image, ref);
   std::printf("  with emission: projection (4) against the double integral %.2e\n", err);
   EXPECT_LT(err, 1e-2);
 }

@@ -118,19 +118,7 @@ TEST(SpectralDiffuse, MethodsAgreeOnTheSameLight) {
     if (diffuse) in.diffuse = &light;
     return resolve_filters(render_spectral(in, Backend::Cpu), m);
   };
-  const auto worst = [](const Image& a, const Image& ref) {
-    double w = 0;
-    const size_t plane = ref.plane_size();
-    for (size_t b = 0; b < ref.bands.size(); ++b) {
-      double peak = 0;
-      for (size_t i = 0; i < plane; ++i) peak = std::max(peak, double(ref.pixels[b * plane + i]));
-      for (size_t i = 0; i < plane; ++i) {
-        const double r = ref.pixels[b * plane + i];
-        if (r > 1e-3 * peak) w = std::max(w, std::fabs(a.pixels[b * plane + i] - r) / r);
-      }
-    }
-    return w;
-  };
+  const auto worst = testing::worst_relative_per_band;
   const Image ref = render(SpectralMethod::Double, 4, 400, true);
   const Image without = render(SpectralMethod::Double, 4, 400, false);
   double with_sum = 0, without_sum = 0;

@@ -12,11 +12,7 @@
 namespace nebula::spectral {
 namespace {
 
-std::vector<std::pair<std::string, Passband>> filters(std::initializer_list<const char*> names) {
-  std::vector<std::pair<std::string, Passband>> out;
-  for (const char* n : names) out.push_back({n, load_filter(n)});
-  return out;
-}
+using testing::filters;
 
 // A uniform cube of n voxels a side, tau_V t per voxel, seen face-on by an
 // orthographic camera: every ray crosses n whole voxels, the k-th (from the

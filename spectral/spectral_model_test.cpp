@@ -7,15 +7,12 @@
 #include "core/philox.h"
 #include "illumination/filters.h"
 #include "spectral/spectral_model.h"
+#include "spectral/spectral_test_scene.h"
 
 namespace nebula::spectral {
 namespace {
 
-std::vector<std::pair<std::string, Passband>> filters(std::initializer_list<const char*> names) {
-  std::vector<std::pair<std::string, Passband>> out;
-  for (const char* n : names) out.push_back({n, load_filter(n)});
-  return out;
-}
+using testing::filters;
 
 // One pair's value through one method: w = 1, the view's add_pair.
 double pair_value(const SpectralModel& m, int filter, int star, double D) {

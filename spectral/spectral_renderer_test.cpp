@@ -11,11 +11,7 @@
 namespace nebula::spectral {
 namespace {
 
-std::vector<std::pair<std::string, Passband>> filters(std::initializer_list<const char*> names) {
-  std::vector<std::pair<std::string, Passband>> out;
-  for (const char* n : names) out.push_back({n, load_filter(n)});
-  return out;
-}
+using testing::filters;
 
 Image render_with(const testing::SpectralTestScene& scene, const SpectralModel& m,
                   const ScatteringTable* table = nullptr, float g = 0.6f) {

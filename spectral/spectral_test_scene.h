@@ -7,10 +7,34 @@
 #include "core/camera.h"
 #include "core/grid.h"
 #include "core/philox.h"
+#include "illumination/filters.h"
 #include "illumination/optical_depth_bake.h"
 #include "spectral/spectral_renderer.h"
 
 namespace nebula::spectral::testing {
+
+// Built-in filters by name, as the spectral model takes them.
+inline std::vector<std::pair<std::string, Passband>> filters(std::initializer_list<const char*> names) {
+  std::vector<std::pair<std::string, Passband>> out;
+  for (const char* n : names) out.push_back({n, load_filter(n)});
+  return out;
+}
+
+// The largest relative error per pixel of `a` against `ref`, over the pixels
+// above 1e-3 of their band's peak (the goals' "pixels with signal").
+inline double worst_relative_per_band(const Image& a, const Image& ref) {
+  double worst = 0;
+  const size_t plane = ref.plane_size();
+  for (size_t b = 0; b < ref.bands.size(); ++b) {
+    double peak = 0;
+    for (size_t i = 0; i < plane; ++i) peak = std::max(peak, double(ref.pixels[b * plane + i]));
+    for (size_t i = 0; i < plane; ++i) {
+      const double r = ref.pixels[b * plane + i];
+      if (r > 1e-3 * peak) worst = std::max(worst, std::fabs(a.pixels[b * plane + i] - r) / r);
+    }
+  }
+  return worst;
+}
 
 struct SpectralTestScene {
   DensityGrid grid;
