@@ -51,6 +51,7 @@
 #include "core/math.h"
 #include "illumination/chord_irradiance.h"
 #include "spectral/expint.h"
+#include "tables/chord_phase.h"
 #include "tables/table_lookup.h"
 
 namespace nebula::spectral {
@@ -165,6 +166,7 @@ struct SpectralSceneView {
   bool varying = false;
   float node_albedo[kMaxTableNodes] = {}, node_g[kMaxTableNodes] = {};
   const float* node_P[kMaxTableNodes] = {};
+  const float* node_C[kMaxTableNodes] = {};  // their cumulative rows (TableView::C; null: the midpoint only)
   const float* lambda_albedo = nullptr;
   const float* lambda_g = nullptr;
 };
@@ -185,8 +187,15 @@ struct PairWeights {
   int n;
   float scale, tau_sct, u;  // tables: w / (a tau_V p_HG), a tau_V, the table's angle coordinate
   float tau_v, mu;          // varying albedo and g: the double integral's thin limit per wavelength
+  float a0, a1;             // mean: P is averaged over the chord's angles a in [a0, a1] (chord_phase_mean)
+  bool mean;
 };
-NEBULA_HD PairWeights pair_weights(const SpectralSceneView& s, float w, float tau_v, float mu) {
+// at: the pair's chord (its angles near a star), or null for a point (the
+// voxel-light pre-pass' centre): a chord seeing the star over enough of a
+// uniform-theta table's bins takes the table's mean over them, as the band
+// marcher does (tables/chord_phase.h); the thin limit keeps the midpoint.
+NEBULA_HD PairWeights pair_weights(const SpectralSceneView& s, float w, float tau_v, float mu,
+                                   const ChordIrradiance* at = nullptr) {
   PairWeights p;
   p.b[0] = w;
   p.n = 1;
@@ -195,22 +204,32 @@ NEBULA_HD PairWeights pair_weights(const SpectralSceneView& s, float w, float ta
   p.u = 0.0f;
   p.tau_v = tau_v;
   p.mu = mu;
+  p.a0 = p.a1 = 0.0f;
+  p.mean = false;
   if (s.n_nodes == 0) return p;
   const float thin = p.tau_sct * hg_phase(mu, s.g);
   p.scale = thin > 0.0f ? w / thin : 0.0f;
   p.u = s.table.angle_coordinate(mu);
+  if (at && s.table.n_mu > 0 && chord_takes_phase_mean(s.table, at->a0, at->a1)) {
+    p.mean = true;
+    p.a0 = at->a0;
+    p.a1 = at->a1;
+  }
   float node[kMaxTableNodes];
   NEBULA_UNROLL
   for (int m = 0; m < kMaxTableNodes; ++m) {
     if (m >= s.n_nodes) break;
+    TableView t = s.table;
+    float tau_sct = p.tau_sct * s.node_kappa[m];
     if (s.varying) {  // the node's own albedo, g and table (or the thin limit)
-      const float tau_sct = s.node_albedo[m] * tau_v * s.node_kappa[m];
-      TableView t = s.table;
+      tau_sct = s.node_albedo[m] * tau_v * s.node_kappa[m];
       t.P = s.node_P[m];
-      node[m] = p.scale * (t.P ? t.lookup_at(tau_sct, p.u) : tau_sct * hg_phase(mu, s.node_g[m])) / s.node_kappa[m];
-    } else {
-      node[m] = p.scale * s.table.lookup_at(p.tau_sct * s.node_kappa[m], p.u) / s.node_kappa[m];
+      t.C = s.node_C[m];
     }
+    const float P = !t.P    ? tau_sct * hg_phase(mu, s.node_g[m])
+                    : p.mean ? chord_phase_mean(t, tau_sct, p.a0, p.a1, nullptr)
+                             : t.lookup_at(tau_sct, p.u);
+    node[m] = p.scale * P / s.node_kappa[m];
   }
   NEBULA_UNROLL
   for (int q = 0; q < kMaxTableNodes; ++q) {
@@ -401,8 +420,10 @@ NEBULA_HD void add_pair(const SpectralSceneView& s, int star, const PairWeights&
         }
       } else {
         for (int i = 0; i < s.n_lambda; ++i) {
-          // P at this wavelength's own scattering depth (q holds S kappa s dlambda).
-          const float e = w.scale * s.table.lookup_at(w.tau_sct * s.kappa[i], w.u) / s.kappa[i] * expf(-s.kappa[i] * D);
+          // P at this wavelength's own scattering depth (q holds S kappa s dlambda), over the chord's angles near a star.
+          const float tau_sct = w.tau_sct * s.kappa[i];
+          const float P = w.mean ? chord_phase_mean(s.table, tau_sct, w.a0, w.a1, nullptr) : s.table.lookup_at(tau_sct, w.u);
+          const float e = w.scale * P / s.kappa[i] * expf(-s.kappa[i] * D);
           for_each_index<Acc::kCols>(s.n_acc, [&](int f) { acc(0, f) += q[f * s.n_lambda + i] * e; });
         }
       }
@@ -500,7 +521,8 @@ NEBULA_HD void add_diffuse(const SpectralSceneView& s, int k, size_t cell, float
   const float* t = s.diffuse + (cell * s.n_stars + k) * size_t(n + 1);
   PairWeights w;
   w.n = n;
-  w.scale = w.tau_sct = w.u = w.tau_v = w.mu = 0.0f;
+  w.scale = w.tau_sct = w.u = w.tau_v = w.mu = w.a0 = w.a1 = 0.0f;
+  w.mean = false;
   const float scale = s.stars[k].power * fraction;
   NEBULA_UNROLL
   for (int p = 0; p < kMaxTableNodes; ++p) w.b[p] = p < n ? scale * t[p] : 0.0f;
@@ -834,7 +856,8 @@ NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir,
           const float r = length(d);
           const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
           const PairWeights w = pair_weights(
-              s, s.stars[k].power * kInv4Pi * at.inv_r2 * s.albedo * tau_v * hg_phase(mu, s.g) * fraction, tau_v, mu);
+              s, s.stars[k].power * kInv4Pi * at.inv_r2 * s.albedo * tau_v * hg_phase(mu, s.g) * fraction, tau_v, mu,
+              &at);
           for_each_index<kMaxTableNodes>(w.n, [&](int p) {
             const float* q = star_integrals(s, k, p, cell, fd);
             for_each_index<Acc::kCols>(F, [&](int f) {
@@ -856,7 +879,7 @@ NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir,
         const float r = length(d);
         const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
         const float w = s.stars[k].power * kInv4Pi * at.inv_r2 * s.albedo * tau_v * hg_phase(mu, s.g) * fraction;
-        add_pair<kMethod>(s, k, pair_weights(s, w, tau_v, mu), s.stars[k].depth_v[cell] + eye_depth, acc);
+        add_pair<kMethod>(s, k, pair_weights(s, w, tau_v, mu, &at), s.stars[k].depth_v[cell] + eye_depth, acc);
         if (s.diffuse) add_diffuse<kMethod>(s, k, cell, fraction, eye_depth, acc);
       });
     }

@@ -71,20 +71,24 @@ void check(const SpectralRenderInputs& in) {
 }
 }  // namespace
 
-void set_table(SpectralSceneView& view, const SpectralRenderInputs& in, const float* P,
-               const std::vector<const float*>& node_P) {
+void set_table(SpectralSceneView& view, const SpectralRenderInputs& in, const float* P, const float* C,
+               const std::vector<const float*>& node_P, const std::vector<const float*>& node_C) {
   if (in.model->varying()) {  // every node its own albedo and g: nodes even in the thin limit
     view.n_nodes = in.model->settings.table_nodes;
     if (in.node_tables.empty()) return;  // the thin limit at each node
     view.table = nebula::view_of(*in.node_tables[0]);  // the axes
-    view.table.C = nullptr;
-    for (size_t k = 0; k < node_P.size(); ++k) view.node_P[k] = node_P[k];
+    view.table.P = node_P[0];
+    view.table.C = node_C[0];
+    for (size_t k = 0; k < node_P.size(); ++k) {
+      view.node_P[k] = node_P[k];
+      view.node_C[k] = node_C[k];
+    }
     return;
   }
   if (!in.table || in.model->settings.table_nodes == 0) return;  // the thin limit
   view.table = nebula::view_of(*in.table);
   view.table.P = P;
-  view.table.C = nullptr;  // only lookup_at is used
+  view.table.C = C;  // the mean over a chord's angles near a star (pair_weights)
   view.n_nodes = in.model->settings.table_nodes;
 }
 
@@ -153,9 +157,15 @@ Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds) {
   view.albedo = in.albedo;
   view.g = in.g;
   view.footprint = in.camera.footprint();
-  std::vector<const float*> node_P;
-  for (const ScatteringTable* t : in.node_tables) node_P.push_back(t->P.data());
-  set_table(view, in, in.table ? in.table->P.data() : nullptr, node_P);
+  std::vector<const float*> node_P, node_C;
+  std::vector<std::vector<float>> cumulative;  // each table's rows' integrals (the chord's mean near a star)
+  for (const ScatteringTable* t : in.node_tables) {
+    cumulative.push_back(cumulative_rows(*t));
+    node_P.push_back(t->P.data());
+    node_C.push_back(cumulative.back().data());
+  }
+  const std::vector<float> C = in.table ? cumulative_rows(*in.table) : std::vector<float>{};
+  set_table(view, in, in.table ? in.table->P.data() : nullptr, C.empty() ? nullptr : C.data(), node_P, node_C);
   const auto start = std::chrono::steady_clock::now();  // the per-view work is timed with the march
   const DiffuseTerms diffuse = diffuse_terms(in, view);
   if (in.diffuse) {

@@ -96,10 +96,11 @@ DiffuseTerms diffuse_terms(const SpectralRenderInputs& in, const SpectralSceneVi
 // lives, host or device, or null for tau_V).
 void set_emission(SpectralSceneView& view, const SpectralRenderInputs& in, const std::vector<const float*>& grids);
 
-// The scene view's table fields for these inputs (both backends; `P` is the
-// table's values where they live, host or device; with varying albedo and g,
-// node_P the node tables' values, where they live).
-void set_table(SpectralSceneView& view, const SpectralRenderInputs& in, const float* P,
-               const std::vector<const float*>& node_P = {});
+// The scene view's table fields for these inputs (both backends; `P` and `C`
+// are the table's values and cumulative rows (tables/table_lookup.h) where they
+// live, host or device; with varying albedo and g, node_P and node_C the node
+// tables', where they live).
+void set_table(SpectralSceneView& view, const SpectralRenderInputs& in, const float* P, const float* C,
+               const std::vector<const float*>& node_P = {}, const std::vector<const float*>& node_C = {});
 
 }  // namespace nebula::spectral

@@ -135,9 +135,13 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
   view.albedo = in.albedo;
   view.g = in.g;
   view.footprint = in.camera.footprint();
-  std::vector<const float*> node_P;
-  for (const ScatteringTable* t : in.node_tables) node_P.push_back(upload(floats, t->P));
-  set_table(view, in, in.table ? upload(floats, in.table->P) : nullptr, node_P);
+  std::vector<const float*> node_P, node_C;
+  for (const ScatteringTable* t : in.node_tables) {
+    node_P.push_back(upload(floats, t->P));
+    node_C.push_back(upload(floats, cumulative_rows(*t)));
+  }
+  set_table(view, in, in.table ? upload(floats, in.table->P) : nullptr,
+            in.table ? upload(floats, cumulative_rows(*in.table)) : nullptr, node_P, node_C);
   // Light between voxels: the per-view arrays where they lie (a CUDA pass leaves them on the
   // device; host arrays are uploaded here), the terms made by a kernel timed with the march.
   const size_t cells = in.density->shape.count();

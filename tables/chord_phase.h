@@ -1,0 +1,50 @@
+#pragma once
+// The mean of a table's P over the scattering angles a voxel's chord sees a
+// star under: the marchers' near-star phase (raycast/ray_march.h and
+// spectral/spectral_march.h; docs/marcher.md, "The phase over the chord's
+// angles").
+#include "core/hd.h"
+#include "core/math.h"
+#include "tables/table_lookup.h"
+
+namespace nebula {
+
+// Near a star a chord sees it under a wide range of angles: with 1 / r^2
+// the chord's light is spread evenly over a = atan(s / b) in [a0, a1]
+// (ChordIrradiance), and the scattering angle towards the eye is
+// theta = pi/2 + a, so the chord scatters the mean of P over those angles.
+// The half-light point takes P at their middle only (the midpoint rule): a
+// chord through the star at 90 degrees, which put the star's own pixels of a
+// uniform sphere (g = 0.6) at 0.74 of the truth (docs/marcher.md, "Star
+// light over a cell's chord"). Spans of kChordPhaseMinBins or more of a
+// uniform-theta table's bins take the mean of its interpolant over them
+// (TableView::mean_over_angles); shorter spans, and uniform-mu tables (whose
+// bins are not uniform in the angle), keep the midpoint.
+constexpr float kChordPhaseMinBins = 2.0f;
+
+// Whether a chord seeing the star over [a0, a1] takes the mean of `table`'s
+// P over those angles.
+NEBULA_HD bool chord_takes_phase_mean(const TableView& table, float a0, float a1) {
+  return table.bins.kind == AngularBinning::UniformTheta &&
+         (a1 - a0) * float(table.n_mu) * (1.0f / kPi) >= kChordPhaseMinBins;
+}
+
+// The mean of P(tau_sct, theta) over theta = pi/2 + a, a in [a0, a1], for
+// uniform-theta bins, where the bin coordinate is linear in the angle.
+NEBULA_HD float chord_phase_mean(const TableView& table, float tau_sct, float a0, float a1, int* clamps) {
+  const float n = float(table.n_mu);
+  // u = (1 - theta / pi) n - 1/2 (AngularBins::position), decreasing in a.
+  const float u_lo = (0.5f - a1 * (1.0f / kPi)) * n - 0.5f, u_hi = (0.5f - a0 * (1.0f / kPi)) * n - 0.5f;
+  return table.mean_over_angles(tau_sct, u_lo, u_hi, clamps);
+}
+
+// The distance from a star beyond which no chord of at most `chord` length
+// spans kChordPhaseMinBins of n_mu angle bins: a chord at distance >= b from
+// the star spans at most chord / b radians (d atan(s / b) / ds <= 1 / b), and
+// the softened b of chord_irradiance is never below the geometric one. 1%
+// above it for the rounding of the angles. 0 for n_mu = 0 (no such table).
+inline float chord_phase_radius(float chord, int n_mu) {
+  return 1.01f * chord * float(n_mu) / (kChordPhaseMinBins * kPi);
+}
+
+}  // namespace nebula
