@@ -123,18 +123,9 @@ NEBULA_HD void scattered_source(const MarchScene& s, float tau_v, Vec3 to_eye, I
                                 to_eye, source, clamps);
 }
 
-// Whether a ray from `origin` along unit `dir` passes within
-// s.near_star_radius of a star: only such rays have chords whose angles
-// chord_phase_mean averages, so the others take the marcher without it (its
-// kernel keeps its registers) and give the same image.
+// Whether a ray passes within s.near_star_radius of a star (tables/chord_phase.h).
 NEBULA_HD bool passes_near_a_star(const MarchScene& s, Vec3 origin, Vec3 dir) {
-  const float r2 = s.near_star_radius * s.near_star_radius;
-  for (int k = 0; k < s.n_stars; ++k) {
-    const Vec3 to_star = s.stars[k].position - origin;
-    const Vec3 off = to_star - fmaxf(dot(to_star, dir), 0.0f) * dir;
-    if (dot(off, off) < r2) return true;
-  }
-  return false;
+  return passes_near_a_star(s.stars, s.n_stars, s.near_star_radius, origin, dir);
 }
 
 // A cell-centred field at `pos`: trilinear (clamped at the grid's edge) or

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/cuda_check.h"
+#include "core/cuda_side_stream.h"
 #include "core/cuda_timer.h"
 #include "core/device_array.h"
 #include "core/device_placement.h"
@@ -122,43 +123,6 @@ struct PinnedStaging {
   }
   ~PinnedStaging() {
     if (data) cudaFreeHost(data);
-  }
-};
-// A second stream for the rays near a star (RaySet::Near) and the events that
-// order it against the default stream: their launch runs beside the main one
-// instead of after it. A few thousand rays marched alone cost about one ray's
-// latency through the grid, most of a frame's wave (H100: 0.6-0.7 ms of a
-// 5.1 ms frame, docs/performance.md); beside the main launch they fill
-// multiprocessor slots it leaves free.
-struct SideStream {
-  cudaStream_t stream = nullptr;
-  cudaEvent_t ready = nullptr, done = nullptr;
-  void start() {
-    if (!stream) {
-      // The highest priority: its blocks start first, beside the main
-      // launch's, instead of making its tail (6.97-6.98 ms against 6.98-7.61 ms
-      // at the default priority for the 1080p frame with the field, H100).
-      int least = 0, greatest = 0;
-      NEBULA_CUDA_CHECK(cudaDeviceGetStreamPriorityRange(&least, &greatest));
-      NEBULA_CUDA_CHECK(cudaStreamCreateWithPriority(&stream, cudaStreamNonBlocking, greatest));
-      NEBULA_CUDA_CHECK(cudaEventCreateWithFlags(&ready, cudaEventDisableTiming));
-      NEBULA_CUDA_CHECK(cudaEventCreateWithFlags(&done, cudaEventDisableTiming));
-    }
-    // Whatever the default stream queued before (the field's light) comes first.
-    NEBULA_CUDA_CHECK(cudaEventRecord(ready, 0));
-    NEBULA_CUDA_CHECK(cudaStreamWaitEvent(stream, ready, 0));
-  }
-  // The default stream's later work (the timer's stop, the download) waits for it.
-  void join() {
-    NEBULA_CUDA_CHECK(cudaEventRecord(done, stream));
-    NEBULA_CUDA_CHECK(cudaStreamWaitEvent(0, done, 0));
-  }
-  ~SideStream() {
-    if (stream) {
-      cudaEventDestroy(ready);
-      cudaEventDestroy(done);
-      cudaStreamDestroy(stream);
-    }
   }
 };
 struct FrameBuffers {

@@ -167,6 +167,9 @@ struct SpectralSceneView {
   float node_albedo[kMaxTableNodes] = {}, node_g[kMaxTableNodes] = {};
   const float* node_P[kMaxTableNodes] = {};
   const float* node_C[kMaxTableNodes] = {};  // their cumulative rows (TableView::C; null: the midpoint only)
+  // Rays within this distance of a star take the phase's mean over their chords' angles
+  // (march_spectral<kMethod, true>; tables/chord_phase.h); 0: none (the thin limit, uniform-mu tables).
+  float near_star_radius = 0.0f;
   const float* lambda_albedo = nullptr;
   const float* lambda_g = nullptr;
 };
@@ -814,7 +817,17 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
 
 // One ray: the accumulators (n_acc of them) before the resolve.
 // em: the emission's planes (n_emission_planes of them; null without emission).
-template <SpectralMethod kMethod, class Acc>
+// Whether a ray passes within s.near_star_radius of a star: only those take
+// the phase's mean over their chords' angles (kChordPhase below).
+NEBULA_HD bool passes_near_a_star(const SpectralSceneView& s, Vec3 origin, Vec3 dir) {
+  return nebula::passes_near_a_star(s.stars, s.n_stars, s.near_star_radius, origin, dir);
+}
+
+// kChordPhase: the pairs whose chords see a star over enough of the table's
+// angle bins take the mean of P over them (pair_weights); only the rays that
+// passes_near_a_star picks have such chords, so the others march without it
+// and the kernel marching them keeps its registers (the image is the same).
+template <SpectralMethod kMethod, bool kChordPhase = false, class Acc>
 NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir, Acc& acc, float* em = nullptr) {
   acc.cols = accumulator_cols(s);
   for_each_index<Acc::kRows>(accumulator_rows(s), [&](int r) {
@@ -857,7 +870,7 @@ NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir,
           const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
           const PairWeights w = pair_weights(
               s, s.stars[k].power * kInv4Pi * at.inv_r2 * s.albedo * tau_v * hg_phase(mu, s.g) * fraction, tau_v, mu,
-              &at);
+              kChordPhase ? &at : nullptr);
           for_each_index<kMaxTableNodes>(w.n, [&](int p) {
             const float* q = star_integrals(s, k, p, cell, fd);
             for_each_index<Acc::kCols>(F, [&](int f) {
@@ -879,7 +892,8 @@ NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir,
         const float r = length(d);
         const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
         const float w = s.stars[k].power * kInv4Pi * at.inv_r2 * s.albedo * tau_v * hg_phase(mu, s.g) * fraction;
-        add_pair<kMethod>(s, k, pair_weights(s, w, tau_v, mu, &at), s.stars[k].depth_v[cell] + eye_depth, acc);
+        add_pair<kMethod>(s, k, pair_weights(s, w, tau_v, mu, kChordPhase ? &at : nullptr), s.stars[k].depth_v[cell] + eye_depth,
+                          acc);
         if (s.diffuse) add_diffuse<kMethod>(s, k, cell, fraction, eye_depth, acc);
       });
     }

@@ -83,13 +83,16 @@ void set_table(SpectralSceneView& view, const SpectralRenderInputs& in, const fl
       view.node_P[k] = node_P[k];
       view.node_C[k] = node_C[k];
     }
-    return;
+  } else {
+    if (!in.table || in.model->settings.table_nodes == 0) return;  // the thin limit
+    view.table = nebula::view_of(*in.table);
+    view.table.P = P;
+    view.table.C = C;  // the mean over a chord's angles near a star (pair_weights)
+    view.n_nodes = in.model->settings.table_nodes;
   }
-  if (!in.table || in.model->settings.table_nodes == 0) return;  // the thin limit
-  view.table = nebula::view_of(*in.table);
-  view.table.P = P;
-  view.table.C = C;  // the mean over a chord's angles near a star (pair_weights)
-  view.n_nodes = in.model->settings.table_nodes;
+  // The rays that can have chords seeing a star over several angle bins (tables/chord_phase.h).
+  if (view.table.bins.kind == AngularBinning::UniformTheta && view.table.C)
+    view.near_star_radius = chord_phase_radius(std::sqrt(3.0f) * in.density->shape.voxel, view.table.n_mu);
 }
 
 void set_emission(SpectralSceneView& view, const SpectralRenderInputs& in, const std::vector<const float*>& grids) {
@@ -204,7 +207,10 @@ Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds) {
         for (int x = 0; x < in.camera.width; ++x) {
           Vec3 origin, dir;
           if (!in.camera.ray(x, y, origin, dir)) continue;
-          march_spectral<method()>(view, origin, dir, acc, em);
+          if (passes_near_a_star(view, origin, dir))
+            march_spectral<method(), true>(view, origin, dir, acc, em);
+          else
+            march_spectral<method(), false>(view, origin, dir, acc, em);
           store_accumulators(view, acc, &image.at(0, x, y), image.plane_size());
           store_emission(view, em, &image.at(0, x, y), image.plane_size());
         }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/cuda_check.h"
+#include "core/cuda_side_stream.h"
 #include "core/cuda_timer.h"
 #include "core/device_array.h"
 #include "spectral/spectral_renderer.h"
@@ -15,16 +16,23 @@
 namespace nebula::spectral {
 namespace {
 
-template <SpectralMethod kMethod, class Acc>
+thread_local SideStream near_rays;  // the launch of the rays near a star (spectral_kernel)
+
+// kNear: the rays passes_near_a_star picks (the phase's mean over their
+// chords' angles), else the others; a launch of each marches every pixel once.
+// The split keeps that mean out of the main kernel's registers (the near
+// rays' launch runs beside it on a SideStream); the image is the CPU loop's.
+template <SpectralMethod kMethod, class Acc, bool kNear>
 __global__ void spectral_kernel(SpectralSceneView scene, Camera camera, float* pixels) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x;
   const int y = blockIdx.y * blockDim.y + threadIdx.y;
   if (x >= camera.width || y >= camera.height) return;
   Vec3 origin, dir;
   if (!camera.ray(x, y, origin, dir)) return;
+  if (passes_near_a_star(scene, origin, dir) != kNear) return;
   Acc acc;
   float em[kMaxEmissionPlanes];  // local memory, touched only with emission
-  march_spectral<kMethod>(scene, origin, dir, acc, em);
+  march_spectral<kMethod, kNear>(scene, origin, dir, acc, em);
   const size_t stride = size_t(camera.width) * camera.height;
   store_accumulators(scene, acc, pixels + size_t(y) * camera.width + x, stride);
   store_emission(scene, em, pixels + size_t(y) * camera.width + x, stride);
@@ -212,7 +220,15 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
   }
   dispatch_method(m.settings.method, [&](auto method) {
     with_accumulators<method()>(view, [&](auto acc) {
-      spectral_kernel<method(), decltype(acc)><<<grid, block>>>(view, in.camera, pixels.get());
+      if (view.near_star_radius > 0.0f && view.n_stars > 0) {
+        near_rays.start();
+        spectral_kernel<method(), decltype(acc), true>
+            <<<grid, block, 0, near_rays.stream>>>(view, in.camera, pixels.get());
+        spectral_kernel<method(), decltype(acc), false><<<grid, block>>>(view, in.camera, pixels.get());
+        near_rays.join();
+      } else {
+        spectral_kernel<method(), decltype(acc), false><<<grid, block>>>(view, in.camera, pixels.get());
+      }
     });
   });
   NEBULA_CUDA_CHECK(cudaGetLastError());

@@ -47,4 +47,20 @@ inline float chord_phase_radius(float chord, int n_mu) {
   return 1.01f * chord * float(n_mu) / (kChordPhaseMinBins * kPi);
 }
 
+// Whether a ray from `origin` along unit `dir` passes within `radius`
+// (chord_phase_radius) of one of the n stars (each with a .position): only
+// such rays have chords whose angles chord_phase_mean averages, so the
+// marchers march the others without it (their kernels keep their registers)
+// and give the same image.
+template <class Star>
+NEBULA_HD bool passes_near_a_star(const Star* stars, int n, float radius, Vec3 origin, Vec3 dir) {
+  const float r2 = radius * radius;
+  for (int k = 0; k < n; ++k) {
+    const Vec3 to_star = stars[k].position - origin;
+    const Vec3 off = to_star - fmaxf(dot(to_star, dir), 0.0f) * dir;
+    if (dot(off, off) < r2) return true;
+  }
+  return false;
+}
+
 }  // namespace nebula
