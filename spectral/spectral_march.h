@@ -815,14 +815,14 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
   }
 }
 
-// One ray: the accumulators (n_acc of them) before the resolve.
-// em: the emission's planes (n_emission_planes of them; null without emission).
 // Whether a ray passes within s.near_star_radius of a star: only those take
 // the phase's mean over their chords' angles (kChordPhase below).
 NEBULA_HD bool passes_near_a_star(const SpectralSceneView& s, Vec3 origin, Vec3 dir) {
   return nebula::passes_near_a_star(s.stars, s.n_stars, s.near_star_radius, origin, dir);
 }
 
+// One ray: the accumulators (n_acc of them) before the resolve.
+// em: the emission's planes (n_emission_planes of them; null without emission).
 // kChordPhase: the pairs whose chords see a star over enough of the table's
 // angle bins take the mean of P over them (pair_weights); only the rays that
 // passes_near_a_star picks have such chords, so the others march without it
