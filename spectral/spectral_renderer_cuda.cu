@@ -39,9 +39,15 @@ __global__ void spectral_kernel(SpectralSceneView scene, Camera camera, float* p
 }
 
 // VoxelLight's per-view pre-pass: one voxel per thread (spectral_march.h);
-// kFN >= F N keeps its sums in registers.
+// kFN >= F N keeps its sums in registers. With the table read at 3 attenuations
+// it took 156 registers, so one block of 256 threads (8 warps) per
+// multiprocessor: blocks of 128 held to 128 registers run 16 warps, and six
+// stars' frame went 2.02 -> 1.83 ms, one star's 1.47 -> 1.50 ms (H200, noise
+// cube 96^3, 512^2; blocks of 128 without the bound 1.94 ms; docs/performance.md).
+constexpr int kVoxelLightBlock = 128;
 template <int kFN>
-__global__ void voxel_light_kernel(SpectralSceneView scene, Camera camera, float* light, unsigned* near) {
+__global__ void __launch_bounds__(kVoxelLightBlock, 4)
+    voxel_light_kernel(SpectralSceneView scene, Camera camera, float* light, unsigned* near) {
   const GridShape& g = scene.density.shape;
   const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i >= g.count()) return;
@@ -213,10 +219,11 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
   }
   if (voxel) {  // the pre-pass, timed with the march
     const int FN = m.n_acc * int(m.basis.size());
+    const unsigned blocks = unsigned((cells + kVoxelLightBlock - 1) / kVoxelLightBlock);
     if (FN <= 16)
-      voxel_light_kernel<16><<<pre_blocks, 256>>>(view, in.camera, light.get(), near.get());
+      voxel_light_kernel<16><<<blocks, kVoxelLightBlock>>>(view, in.camera, light.get(), near.get());
     else
-      voxel_light_kernel<0><<<pre_blocks, 256>>>(view, in.camera, light.get(), near.get());
+      voxel_light_kernel<0><<<blocks, kVoxelLightBlock>>>(view, in.camera, light.get(), near.get());
   }
   dispatch_method(m.settings.method, [&](auto method) {
     with_accumulators<method()>(view, [&](auto acc) {
