@@ -38,6 +38,21 @@ class SpectralScene : public testing::TempDirTest {
     o.table_photons = 1000;
     return o;
   }
+  // Three top-hat filters 10 nm wide at 450, 550 and 700 nm (bands n450, n550,
+  // n700), where the band model is nearly the spectral integral, each band
+  // reading the smooth table: a scene's bands, [filters] and [dust] tables.
+  std::string narrow_filters() {
+    std::string bands = "bands = [", files = "[filters]\n", tables = "[dust]\ntables = { ";
+    for (int nm : {450, 550, 700}) {
+      const std::string name = "n" + std::to_string(nm), sep = nm == 700 ? "" : ", ";
+      write_text(name + ".txt", "# 10 nm top hat\n" + std::to_string(nm - 6) + " 0\n" + std::to_string(nm - 5) +
+                                    " 1\n" + std::to_string(nm + 5) + " 1\n" + std::to_string(nm + 6) + " 0\n");
+      bands += "\"" + name + "\"" + sep;
+      files += name + " = \"" + name + ".txt\"\n";
+      tables += name + " = \"smooth.h5\"" + sep;
+    }
+    return bands + "]\n" + files + tables + " }\n";
+  }
   RenderOutput render(const std::string& spectral) { return render_scene(scene(spectral), options()); }
   Scene scene(const std::string& spectral, const std::vector<std::string>& overrides = {}) {
     write_text("ha.txt", "# H-alpha, 6 nm\n650 0\n653 1\n659 1\n662 0\n");
@@ -182,17 +197,8 @@ TEST_F(SpectralScene, EmissionThroughTheFilters) {
 // single-scattered light (the band model's own error, which the light between
 // voxels inherits).
 TEST_F(SpectralScene, LightBetweenVoxelsAgreesWithTheBandRenderer) {
-  std::string files = "[filters]\n";
-  std::string tables = "[dust]\ntables = { ";
-  for (int nm : {450, 550, 700}) {
-    const std::string name = "n" + std::to_string(nm);
-    write_text(name + ".txt", "# 10 nm top hat\n" + std::to_string(nm - 6) + " 0\n" + std::to_string(nm - 5) +
-                                  " 1\n" + std::to_string(nm + 5) + " 1\n" + std::to_string(nm + 6) + " 0\n");
-    files += name + " = \"" + name + ".txt\"\n";
-    tables += name + " = \"smooth.h5\"" + (nm == 700 ? " }\n" : ", ");
-  }
   const auto totals = [&](bool spectral, const std::vector<std::string>& overrides) {
-    const std::string text = "bands = [\"n450\", \"n550\", \"n700\"]\n" + files + tables +
+    const std::string text = narrow_filters() +
                              "[density]\nprocedural = { n = 24, size_pc = 2.0 }\n"
                              "[[stars]]\nluminosity_lsun = 2e5\nclass = \"O5V\"\n"
                              "[camera]\nposition = [1, -2.5, 1]\nlook_at = [1, 1, 1]\nwidth = 40\nheight = 32\n"
@@ -245,17 +251,8 @@ TEST_F(SpectralScene, LightBetweenVoxelsAgreesWithTheBandRenderer) {
 // sphere renders alike per pixel with either renderer, its brightest pixels
 // included (with the midpoint angle alone they differ by 5% there).
 TEST_F(SpectralScene, ChordsNearAStarTakeThePhaseMeanAsTheBandRenderer) {
-  std::string files = "[filters]\n";
-  std::string tables = "[dust]\ntables = { ";
-  for (int nm : {450, 550, 700}) {
-    const std::string name = "n" + std::to_string(nm);
-    write_text(name + ".txt", "# 10 nm top hat\n" + std::to_string(nm - 6) + " 0\n" + std::to_string(nm - 5) +
-                                  " 1\n" + std::to_string(nm + 5) + " 1\n" + std::to_string(nm + 6) + " 0\n");
-    files += name + " = \"" + name + ".txt\"\n";
-    tables += name + " = \"smooth.h5\"" + (nm == 700 ? " }\n" : ", ");
-  }
   const auto render_sphere = [&](bool spectral) {
-    const std::string text = "bands = [\"n450\", \"n550\", \"n700\"]\n" + files + tables +
+    const std::string text = narrow_filters() +
                              "[density.procedural]\nn = 32\nsize_pc = 2.0\nstar = [0.5, 0.5, 0.5]\n"
                              "bubble_offset = 0.0\nbubble_radius = 0.4\nbubble_tau = 2.5\nshell_tau = 0.0\n"
                              "cloud_tau = 0.0\nfar_multiplier = 1.0\nnoise_amplitude = 0.0\n"

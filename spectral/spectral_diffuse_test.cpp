@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstdio>
 
-#include "illumination/filters.h"
 #include "spectral/spectral_test_scene.h"
 #include "tables/test_tables.h"
 
@@ -17,8 +16,7 @@ namespace nebula::spectral {
 namespace {
 
 SpectralModel bvr_model(int nodes, SpectralMethod method = SpectralMethod::Projection) {
-  std::vector<std::pair<std::string, Passband>> f;
-  for (const char* n : {"B", "V", "R"}) f.push_back({n, load_filter(n)});
+  const auto f = testing::filters({"B", "V", "R"});
   SpectralSettings s;
   s.method = method;
   s.table_nodes = nodes;
@@ -103,8 +101,7 @@ TEST(SpectralDiffuse, EyeDepthKeepsTheForwardPeakAtV) {
 TEST(SpectralDiffuse, MethodsAgreeOnTheSameLight) {
   auto scene = testing::noise_scene(16, 0.5f, {{0.1f, 0.2f, -0.1f}, {-0.3f, 0.0f, 0.2f}}, 32, 24);
   const ScatteringTable table = nebula::testing::make_test_table(5.0, 501, AngularBinning::UniformTheta, 90, 0.6);
-  std::vector<std::pair<std::string, Passband>> f;
-  for (const char* n : {"B", "V", "R"}) f.push_back({n, load_filter(n)});
+  const auto f = testing::filters({"B", "V", "R"});
   const auto render = [&](SpectralMethod method, int basis, int wavelengths, bool diffuse) {
     SpectralSettings s;
     s.method = method;

@@ -174,6 +174,17 @@ struct SpectralSceneView {
   const float* lambda_g = nullptr;
 };
 
+// A depth D's place on the star tables' depth axis (steps of depth_step): the
+// row d0 below it and the fraction fd to the next; false beyond the last row,
+// where the light is below the transmittance cut.
+NEBULA_HD bool depth_row(const SpectralSceneView& s, float D, int& d0, float& fd) {
+  const float x = D / s.depth_step;
+  if (!(x < float(s.n_depth - 1))) return false;
+  d0 = int(x);
+  fd = x - float(d0);
+  return true;
+}
+
 // Henyey-Greenstein phase function per steradian.
 NEBULA_HD float hg_phase(float mu, float g) {
   const float d = 1.0f + g * g - 2.0f * g * mu;
@@ -383,10 +394,9 @@ NEBULA_HD void add_emission(const SpectralSceneView& s, size_t cell, float tau_v
         out[f] += w * float(sum);
       }
     } else {
-      const float x = D / s.depth_step;
-      if (!(x < float(s.n_depth - 1))) continue;  // beyond the table: below the transmittance cut
-      const int d0 = int(x);
-      const float fd = x - float(d0);
+      int d0;
+      float fd;
+      if (!depth_row(s, D, d0, fd)) continue;
       // Preintegrated: the component's own table, one number per filter; else c_j(D), one per element.
       const int N = kMethod == SpectralMethod::Preintegrated ? s.n_acc : s.n_basis;
       const float* c0 = s.emission_coeff +
@@ -467,10 +477,9 @@ NEBULA_HD void add_pair(const SpectralSceneView& s, int star, const PairWeights&
     case SpectralMethod::VoxelLight:
       break;  // summed per voxel ahead of the march (voxel_light)
     case SpectralMethod::Preintegrated: {
-      const float x = D / s.depth_step;
-      if (!(x < float(s.n_depth - 1))) break;  // beyond the table: below the transmittance cut
-      const int d0 = int(x);
-      const float fd = x - float(d0);
+      int d0;
+      float fd;
+      if (!depth_row(s, D, d0, fd)) break;
       const int F = s.n_acc;
       for_each_index<kMaxTableNodes>(w.n, [&](int p) {
         const float* q = s.star_coeff + ((size_t(star) * s.n_powers + p) * s.n_depth + d0) * F;
@@ -481,10 +490,9 @@ NEBULA_HD void add_pair(const SpectralSceneView& s, int star, const PairWeights&
     }
     case SpectralMethod::Projection:
     case SpectralMethod::LightBasis: {
-      const float x = D / s.depth_step;
-      if (!(x < float(s.n_depth - 1))) break;  // beyond the table: below the transmittance cut
-      const int d0 = int(x);
-      const float fd = x - float(d0);
+      int d0;
+      float fd;
+      if (!depth_row(s, D, d0, fd)) break;
       const int N = s.n_basis;
       // One block of coefficient tables per power of kappa; without a table the
       // first alone (its own branch, so that the thin limit's code is what it was).
@@ -549,10 +557,9 @@ NEBULA_HD void add_diffuse(const SpectralSceneView& s, int k, size_t cell, float
 // kWidth > 0 bounds width at compile time (RayAccumulators).
 template <int kWidth = 0>
 NEBULA_HD bool depth_coefficients(const SpectralSceneView& s, const float* table, int width, float D, float* out) {
-  const float x = D / s.depth_step;
-  if (!(x < float(s.n_depth - 1))) return false;
-  const int d0 = int(x);
-  const float fd = x - float(d0);
+  int d0;
+  float fd;
+  if (!depth_row(s, D, d0, fd)) return false;
   const float* c0 = table + size_t(d0) * width;
   for_each_index<kWidth>(width, [&](int i) { out[i] = c0[i] + fd * (c0[width + i] - c0[i]); });
   return true;
@@ -564,10 +571,8 @@ NEBULA_HD size_t star_row(const SpectralSceneView& s, int k, int p, int d0) {
   return ((size_t(k) * s.n_powers + p) * s.n_depth + d0) * (s.n_acc * s.n_basis);
 }
 NEBULA_HD const float* star_integrals(const SpectralSceneView& s, int k, int p, size_t cell, float& fd) {
-  const float x = s.stars[k].depth_v[cell] / s.depth_step;
-  if (!(x < float(s.n_depth - 1))) return nullptr;
-  const int d0 = int(x);
-  fd = x - float(d0);
+  int d0;
+  if (!depth_row(s, s.stars[k].depth_v[cell], d0, fd)) return nullptr;
   return s.star_coeff + star_row(s, k, p, d0);
 }
 
@@ -697,10 +702,9 @@ template <int kFN = 0>
 NEBULA_HD void add_diffuse_light(const SpectralSceneView& s, float* __restrict__ u, int k, size_t cell) {
   const int n = s.n_nodes, FN = s.n_acc * s.n_basis;
   const float* t = s.diffuse + (cell * s.n_stars + k) * size_t(n + 1);
-  const float x = t[n] / s.depth_step;
-  if (!(x < float(s.n_depth - 1))) return;  // beyond the table: below the transmittance cut
-  const int d0 = int(x);
-  const float fd = x - float(d0);
+  int d0;
+  float fd;
+  if (!depth_row(s, t[n], d0, fd)) return;
   const size_t block = size_t(s.n_depth) * FN;
   const float* q0 = s.star_coeff + star_row(s, k, 0, d0);
   const float power = s.stars[k].power;

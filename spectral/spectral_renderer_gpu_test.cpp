@@ -4,7 +4,6 @@
 #include <cstdio>
 
 #include "core/gpu.h"
-#include "illumination/filters.h"
 #include "spectral/spectral_test_scene.h"
 #include "tables/test_tables.h"
 
@@ -30,8 +29,7 @@ TEST(SpectralRendererGpu, AgreesWithTheCpu) {
   std::string why;
   if (!gpu_available(&why)) GTEST_SKIP() << why;
   auto scene = testing::noise_scene(24, 0.6f, {{0.1f, 0.2f, -0.1f}, {-0.3f, 0.0f, 0.2f}}, 64, 48);
-  std::vector<std::pair<std::string, Passband>> f;
-  for (const char* n : {"B", "V", "R"}) f.push_back({n, load_filter(n)});
+  const auto f = testing::filters({"B", "V", "R"});
   const ScatteringTable table = nebula::testing::make_test_table(5.0, 501, AngularBinning::UniformTheta, 90, 0.6);
   for (SpectralMethod method : {SpectralMethod::Double, SpectralMethod::Analytic, SpectralMethod::Projection,
                                 SpectralMethod::LightBasis, SpectralMethod::VoxelLight,
@@ -56,8 +54,7 @@ TEST(SpectralRendererGpu, LightBetweenVoxelsAgreesWithTheCpu) {
   std::string why;
   if (!gpu_available(&why)) GTEST_SKIP() << why;
   auto scene = testing::noise_scene(24, 0.6f, {{0.1f, 0.2f, -0.1f}, {-0.3f, 0.0f, 0.2f}}, 64, 48);
-  std::vector<std::pair<std::string, Passband>> f;
-  for (const char* n : {"B", "V", "R"}) f.push_back({n, load_filter(n)});
+  const auto f = testing::filters({"B", "V", "R"});
   const ScatteringTable table = nebula::testing::make_test_table(5.0, 501, AngularBinning::UniformTheta, 90, 0.6);
   for (SpectralMethod method : {SpectralMethod::Double, SpectralMethod::Analytic, SpectralMethod::Projection,
                                 SpectralMethod::LightBasis, SpectralMethod::VoxelLight,
@@ -84,8 +81,7 @@ TEST(SpectralRendererGpu, VaryingAlbedoAndGAgreeWithTheCpu) {
   std::string why;
   if (!gpu_available(&why)) GTEST_SKIP() << why;
   auto scene = testing::noise_scene(20, 0.6f, {{0.1f, 0.2f, -0.1f}, {-0.3f, 0.0f, 0.2f}}, 48, 40);
-  std::vector<std::pair<std::string, Passband>> f;
-  for (const char* n : {"B", "V", "R"}) f.push_back({n, load_filter(n)});
+  const auto f = testing::filters({"B", "V", "R"});
   for (SpectralMethod method : {SpectralMethod::Double, SpectralMethod::Projection, SpectralMethod::LightBasis,
                                 SpectralMethod::VoxelLight, SpectralMethod::Preintegrated})
     for (bool with_tables : {false, true}) {
@@ -120,8 +116,7 @@ TEST(SpectralRendererGpu, EmissionAgreesWithTheCpu) {
   auto scene = testing::noise_scene(20, 0.6f, {{0.1f, 0.2f, -0.1f}, {-0.3f, 0.0f, 0.2f}}, 48, 40);
   std::vector<float> weight(scene.grid.tau_v.size());
   for (size_t i = 0; i < weight.size(); ++i) weight[i] = 0.1f * float(i % 5);
-  std::vector<std::pair<std::string, Passband>> f;
-  for (const char* n : {"B", "V", "R"}) f.push_back({n, load_filter(n)});
+  const auto f = testing::filters({"B", "V", "R"});
   for (SpectralMethod method : {SpectralMethod::Double, SpectralMethod::Analytic, SpectralMethod::Projection,
                                 SpectralMethod::LightBasis, SpectralMethod::VoxelLight,
                                 SpectralMethod::Preintegrated}) {

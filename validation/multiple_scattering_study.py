@@ -15,17 +15,13 @@ against truth.
 
 Writes the Markdown page (--out), the rows as JSON beside it, and prints each row.
 """
-import argparse
-import json
 import os
-import shutil
 import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "validation"))
-from accuracy_report import write_densities  # noqa: E402  (the layer and wedge grids)
-from nebula_runner import Runner  # noqa: E402
+from nebula_runner import Runner, prepare_work, study_arguments, truth_grid, write_rows  # noqa: E402
 
 SCENES = ["fig12_reference", "thin_nebula", "thick_nebula", "layer_front", "layer_behind", "wedge", "sphere_tau1",
           "sphere_tau5", "axial_lopsided", "axial_lopsided_thick"]
@@ -48,23 +44,10 @@ def scene_path(work, name):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--nebula", default=os.path.join(ROOT, "build", "bin", "nebula"))
-    ap.add_argument("--backend", default="auto")
-    ap.add_argument("--work", default="/tmp/nebula-ms-study")
-    ap.add_argument("--spp", type=int, default=512, help="truth samples per pixel")
-    ap.add_argument("--fig12-pixels", type=int, default=128, help="image size of the Fig. 12 scene")
-    ap.add_argument("--albedos", default="0.3,0.6,0.9")
-    ap.add_argument("--gs", default="0,0.6,0.9")
-    ap.add_argument("--scenes", default=",".join(SCENES))
+    ap = study_arguments(__doc__.split("\n")[0], "/tmp/nebula-ms-study", "docs/multiple_scattering.md", SCENES)
     ap.add_argument("--methods", default=",".join(METHODS))
-    ap.add_argument("--out", default="docs/multiple_scattering.md")
-    ap.add_argument("--machine", default="", help="the machine, for the page")
     args = ap.parse_args()
-    os.makedirs(args.work, exist_ok=True)
-    for f in os.listdir(os.path.join(ROOT, "validation", "scenes")):
-        shutil.copy(os.path.join(ROOT, "validation", "scenes", f), args.work)
-    write_densities(args.work)
+    prepare_work(args)
     r = Runner(args)
     albedos = [float(a) for a in args.albedos.split(",")]
     gs = [float(g) for g in args.gs.split(",")]
@@ -73,36 +56,23 @@ def main():
     start = time.time()
     for scene in args.scenes.split(","):
         path = scene_path(args.work, scene)
-        size = ["--width", str(args.fig12_pixels), "--height", str(args.fig12_pixels)] if scene == "fig12_reference" \
-            else []
-        for a in albedos:
-            for g in gs:
-                dust = ["--set", f"dust.albedo={a}", "--set", f"dust.g={g}"]
-                tag = f"{scene}_a{a}_g{g}"
-                truth = os.path.join(args.work, f"truth_{tag}.h5")
+        for a, g, shared, tag, truth, truth_seconds in truth_grid(r, args, scene, path):
+            for method in methods:
+                if scene.startswith("axial") and method.startswith("pyramid"):
+                    continue  # the pyramid is built from 3D grids; axial maps refuse it
+                out = os.path.join(args.work, f"fast_{tag}_{method.split()[0]}{method.split()[-1]}.h5")
                 t0 = time.time()
-                r.run(["truth", path, "--spp", str(args.spp), "--equiangular", "--backend", r.backend, "-q",
-                       "--force", "-o", truth] + size + dust)
-                truth_seconds = time.time() - t0
-                for method in methods:
-                    if scene.startswith("axial") and method.startswith("pyramid"):
-                        continue  # the pyramid is built from 3D grids; axial maps refuse it
-                    out = os.path.join(args.work, f"fast_{tag}_{method.split()[0]}{method.split()[-1]}.h5")
-                    t0 = time.time()
-                    r.run(["render", path, "--backend", r.backend, "-q", "--force", "-o", out] + size + dust +
-                          METHODS[method])
-                    seconds = time.time() - t0
-                    bands = r.compare(out, truth)
-                    v = [b for b in bands if b["band"] == "V"][0]
-                    row = dict(scene=scene, albedo=a, g=g, method=method, bias=v["bias"], bias_stderr=v["bias_stderr"],
-                               excess=v["rel_l2_excess"], worst_1pct=v["worst_1pct"], noise=v["noise_rel_l2"],
-                               bias_bands=[b["bias"] for b in bands], seconds=seconds, truth_seconds=truth_seconds)
-                    rows.append(row)
-                    print(f"{scene:16s} a {a} g {g} {method:18s} bias {100 * row['bias']:+6.1f}% "
-                          f"+- {100 * row['bias_stderr']:.1f}%  excess L2 {row['excess']:.3f}", flush=True)
-    with open(args.out + ".json.tmp", "w") as f:
-        json.dump(rows, f, indent=1)
-    os.replace(args.out + ".json.tmp", os.path.splitext(args.out)[0] + ".json")
+                r.run(["render", path, "--backend", r.backend, "-q", "--force", "-o", out] + shared + METHODS[method])
+                seconds = time.time() - t0
+                bands = r.compare(out, truth)
+                v = [b for b in bands if b["band"] == "V"][0]
+                row = dict(scene=scene, albedo=a, g=g, method=method, bias=v["bias"], bias_stderr=v["bias_stderr"],
+                           excess=v["rel_l2_excess"], worst_1pct=v["worst_1pct"], noise=v["noise_rel_l2"],
+                           bias_bands=[b["bias"] for b in bands], seconds=seconds, truth_seconds=truth_seconds)
+                rows.append(row)
+                print(f"{scene:16s} a {a} g {g} {method:18s} bias {100 * row['bias']:+6.1f}% "
+                      f"+- {100 * row['bias_stderr']:.1f}%  excess L2 {row['excess']:.3f}", flush=True)
+    write_rows(rows, args.out)
     write_page(rows, args, albedos, gs, methods, time.time() - start)
 
 

@@ -17,17 +17,14 @@ diffuse field baked at each filter's own attenuation), and the albedo's effect.
 
 Writes the Markdown page (--out), the rows as JSON beside it, and prints each row.
 """
-import argparse
-import json
 import os
 import re
-import shutil
 import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "validation"))
-from nebula_runner import Runner  # noqa: E402
+from nebula_runner import Runner, prepare_work, study_arguments, truth_grid, write_rows  # noqa: E402
 
 SCENES = ["fig12_reference", "sphere_tau1", "sphere_tau5"]
 FILTERS = {"n450": 450, "n550": 550, "n700": 700}
@@ -58,24 +55,9 @@ def write_scenes(work, name):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--nebula", default=os.path.join(ROOT, "build", "bin", "nebula"))
-    ap.add_argument("--backend", default="auto")
-    ap.add_argument("--work", default="/tmp/nebula-spectral-truth")
-    ap.add_argument("--spp", type=int, default=512, help="truth samples per pixel")
-    ap.add_argument("--fig12-pixels", type=int, default=128, help="image size of the Fig. 12 scene")
-    ap.add_argument("--albedos", default="0.3,0.6,0.9")
-    ap.add_argument("--gs", default="0,0.6,0.9")
-    ap.add_argument("--scenes", default=",".join(SCENES))
-    ap.add_argument("--out", default="docs/spectral_truth.md")
-    ap.add_argument("--machine", default="", help="the machine, for the page")
+    ap = study_arguments(__doc__.split("\n")[0], "/tmp/nebula-spectral-truth", "docs/spectral_truth.md", SCENES)
     args = ap.parse_args()
-    os.makedirs(args.work, exist_ok=True)
-    for f in os.listdir(os.path.join(ROOT, "validation", "scenes")):
-        shutil.copy(os.path.join(ROOT, "validation", "scenes", f), args.work)
-    if any(s.startswith(("layer", "wedge")) for s in args.scenes.split(",")):
-        from accuracy_report import write_densities  # the layer and wedge grids (numpy, h5py)
-        write_densities(args.work)
+    prepare_work(args)
     r = Runner(args)
     albedos = [float(a) for a in args.albedos.split(",")]
     gs = [float(g) for g in args.gs.split(",")]
@@ -83,34 +65,21 @@ def main():
     start = time.time()
     for scene in args.scenes.split(","):
         paths = write_scenes(args.work, scene)
-        size = ["--width", str(args.fig12_pixels), "--height", str(args.fig12_pixels)] if scene == "fig12_reference" \
-            else []
-        for a in albedos:
-            for g in gs:
-                dust = ["--set", f"dust.albedo={a}", "--set", f"dust.g={g}"]
-                tag = f"{scene}_a{a}_g{g}"
-                truth = os.path.join(args.work, f"truth_{tag}.h5")
+        for a, g, shared, tag, truth, truth_seconds in truth_grid(r, args, scene, paths["band"]):
+            for method, (kind, extra) in METHODS.items():
+                out = os.path.join(args.work, f"{kind}_{tag}_{len(extra)}.h5")
                 t0 = time.time()
-                r.run(["truth", paths["band"], "--spp", str(args.spp), "--equiangular", "--backend", r.backend, "-q",
-                       "--force", "-o", truth] + size + dust)
-                truth_seconds = time.time() - t0
-                for method, (kind, extra) in METHODS.items():
-                    out = os.path.join(args.work, f"{kind}_{tag}_{len(extra)}.h5")
-                    t0 = time.time()
-                    r.run(["render", paths[kind], "--backend", r.backend, "-q", "--force", "-o", out] + size + dust +
-                          extra)
-                    seconds = time.time() - t0
-                    bands = r.compare(out, truth)
-                    row = dict(scene=scene, albedo=a, g=g, method=method, seconds=seconds, truth_seconds=truth_seconds,
-                               bias=[b["bias"] for b in bands], bias_stderr=[b["bias_stderr"] for b in bands],
-                               excess=[b["rel_l2_excess"] for b in bands], noise=[b["noise_rel_l2"] for b in bands])
-                    rows.append(row)
-                    print(f"{scene:16s} a {a} g {g} {method:30s} bias " +
-                          " ".join(f"{100 * x:+6.1f}%" for x in row["bias"]) + "  excess L2 " +
-                          " ".join(f"{x:.3f}" for x in row["excess"]), flush=True)
-    with open(args.out + ".json.tmp", "w") as f:
-        json.dump(rows, f, indent=1)
-    os.replace(args.out + ".json.tmp", os.path.splitext(args.out)[0] + ".json")
+                r.run(["render", paths[kind], "--backend", r.backend, "-q", "--force", "-o", out] + shared + extra)
+                seconds = time.time() - t0
+                bands = r.compare(out, truth)
+                row = dict(scene=scene, albedo=a, g=g, method=method, seconds=seconds, truth_seconds=truth_seconds,
+                           bias=[b["bias"] for b in bands], bias_stderr=[b["bias_stderr"] for b in bands],
+                           excess=[b["rel_l2_excess"] for b in bands], noise=[b["noise_rel_l2"] for b in bands])
+                rows.append(row)
+                print(f"{scene:16s} a {a} g {g} {method:30s} bias " +
+                      " ".join(f"{100 * x:+6.1f}%" for x in row["bias"]) + "  excess L2 " +
+                      " ".join(f"{x:.3f}" for x in row["excess"]), flush=True)
+    write_rows(rows, args.out)
     write_page(rows, args, albedos, gs, time.time() - start)
 
 
