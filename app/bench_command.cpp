@@ -213,7 +213,7 @@ void add_pyramid(CLI::App* bench) {
 
 void add_truth(CLI::App* bench) {
   struct Options : Common {
-    int size = 256, width = 1920, height = 1080, spp = 16;
+    int size = 256, width = 1920, height = 1080, spp = 16, threads_per_pixel = 0;
     std::string transmittance = "both";
     bool equiangular = false;
   };
@@ -228,10 +228,13 @@ void add_truth(CLI::App* bench) {
   cmd->add_option("--transmittance", o->transmittance, "next-event transmittance: ratio, exact or both")
       ->capture_default_str()->check(CLI::IsMember({"ratio", "exact", "both"}));
   cmd->add_flag("--equiangular", o->equiangular, "with equiangular next-event estimation (MIS)");
+  cmd->add_option("--threads-per-pixel", o->threads_per_pixel,
+                  "CUDA threads sharing each pixel's samples (0: as many as fill the GPU)")
+      ->capture_default_str()->check(CLI::Range(0, 1 << 20));
   cmd->callback([o] {
-    std::printf("| backend | transmittance | image | grid | spp | s per run (median of %d) | path vertices/s | "
-                "paths/s | spp/s at this size | spp/s at 1920x1080 | vertices/path |\n"
-                "|---|---|---|---|---|---|---|---|---|---|---|\n",
+    std::printf("| backend | transmittance | image | grid | spp | threads/pixel | s per run (median of %d) | "
+                "path vertices/s | paths/s | spp/s at this size | spp/s at 1920x1080 | vertices/path |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|---|\n",
                 o->repeats);
     std::vector<bool> exact_modes;
     if (o->transmittance != "exact") exact_modes.push_back(false);
@@ -242,11 +245,12 @@ void add_truth(CLI::App* bench) {
         const bool cpu = backend == Backend::Cpu;
         const int w = cpu ? std::max(1, o->width / 10) : o->width, h = cpu ? std::max(1, o->height / 10) : o->height;
         const TruthBenchRow row =
-            bench_truth(backend, o->size, w, h, cpu ? 2 : o->spp, cpu ? 1 : o->repeats, exact, o->equiangular);
+            bench_truth(backend, o->size, w, h, cpu ? 2 : o->spp, cpu ? 1 : o->repeats, exact, o->equiangular,
+                        o->threads_per_pixel);
         // spp/s at 1920x1080: the same paths per second spread over 1920x1080 pixels.
-        std::printf("| %s | %s%s | %dx%d | %d^3 | %d | %.4f | %.3g | %.3g | %.3g | %.3g | %.2f |\n",
+        std::printf("| %s | %s%s | %dx%d | %d^3 | %d | %d | %.4f | %.3g | %.3g | %.3g | %.3g | %.2f |\n",
                     row.backend.c_str(), exact ? "exact" : "ratio", o->equiangular ? "+equiangular" : "", row.width,
-                    row.height, row.size, row.spp, row.median_seconds, row.vertices_per_second, row.paths_per_second,
+                    row.height, row.size, row.spp, row.threads_per_pixel, row.median_seconds, row.vertices_per_second, row.paths_per_second,
                     row.spp_per_second, row.spp_per_second * double(row.width) * row.height / (1920.0 * 1080.0),
                     row.vertices_per_path);
         std::fflush(stdout);

@@ -225,12 +225,18 @@ NEBULA_HD float trace_path(const PathScene& s, int b, Vec3 origin, Vec3 dir, Rng
   return radiance;
 }
 
-// All samples of pixel (x, y): mean and variance of the mean per band
-// (exposure applied), from double sums. spp >= 2, a multiple of the strata
-// (pixel_side^2): stratified samples make this variance an upper bound.
-NEBULA_HD void trace_pixel(const PathScene& s, const Camera& camera, float exposure, int x, int y, int spp,
-                           float* mean, float* variance, PathCounters& c) {
-  for (int b = 0; b < s.n_bands; ++b) mean[b] = variance[b] = 0.0f;
+// Samples [k0, k1) of pixel (x, y): per band the sum of the samples and of
+// their squares, in double. The samples depend only on (pixel, sample,
+// band), never on how a launch splits the range (the GPU gives a small
+// image's pixels to several threads each: truth_renderer_cuda.cu).
+struct PixelSums {
+  double sum[kMaxBands];
+  double sum2[kMaxBands];
+};
+
+NEBULA_HD void trace_pixel_samples(const PathScene& s, const Camera& camera, int x, int y, int k0, int k1,
+                                   PixelSums& out, PathCounters& c) {
+  for (int b = 0; b < kMaxBands; ++b) out.sum[b] = out.sum2[b] = 0.0;
   Vec3 origin, dir;
   const bool centre = camera.ray(x, y, origin, dir);
   if (!centre && s.pixel_side == 1) return;
@@ -238,7 +244,7 @@ NEBULA_HD void trace_pixel(const PathScene& s, const Camera& camera, float expos
   const int strata = s.pixel_side * s.pixel_side;
   for (int b = 0; b < s.n_bands; ++b) {
     double sum = 0.0, sum2 = 0.0;
-    for (int k = 0; k < spp; ++k) {
+    for (int k = k0; k < k1; ++k) {
       if (strata > 1) {
         // The same sub-pixel point in every band (its own stream, band 0xFF).
         PathRng jitter(s.seed, pixel, static_cast<uint32_t>(k), 0xFFu);
@@ -252,12 +258,32 @@ NEBULA_HD void trace_pixel(const PathScene& s, const Camera& camera, float expos
       sum += v;
       sum2 += v * v;
     }
-    const double n = spp;
-    const double m = sum / n;
-    const double var = (sum2 - sum * m) / (n * (n - 1.0));
+    out.sum[b] = sum;
+    out.sum2[b] = sum2;
+  }
+}
+
+// A pixel's mean and the variance of that mean per band (exposure applied)
+// from the sums of all its spp >= 2 samples.
+NEBULA_HD void pixel_moments(const PixelSums& p, int n_bands, int spp, float exposure, float* mean, float* variance) {
+  for (int b = 0; b < kMaxBands; ++b) mean[b] = variance[b] = 0.0f;
+  const double n = spp;
+  for (int b = 0; b < n_bands; ++b) {
+    const double m = p.sum[b] / n;
+    const double var = (p.sum2[b] - p.sum[b] * m) / (n * (n - 1.0));
     mean[b] = static_cast<float>(exposure * m);
     variance[b] = static_cast<float>(double(exposure) * exposure * (var > 0.0 ? var : 0.0));
   }
+}
+
+// All samples of pixel (x, y): mean and variance of the mean per band
+// (exposure applied), from double sums. spp >= 2, a multiple of the strata
+// (pixel_side^2): stratified samples make this variance an upper bound.
+NEBULA_HD void trace_pixel(const PathScene& s, const Camera& camera, float exposure, int x, int y, int spp,
+                           float* mean, float* variance, PathCounters& c) {
+  PixelSums p;
+  trace_pixel_samples(s, camera, x, y, 0, spp, p, c);
+  pixel_moments(p, s.n_bands, spp, exposure, mean, variance);
 }
 
 }  // namespace nebula

@@ -55,6 +55,48 @@ void expect_cpu_and_cuda_agree(bool equiangular) {
               (unsigned long long)gpu.counters.vertices);
 }
 
+// A small image's pixels share their samples among several GPU threads: the
+// same samples, so the image equals the one-thread-per-pixel launch's to the
+// rounding of the double sums' order, whatever the number of shares.
+TEST(TruthGpu, SharingAPixelsSamplesAmongThreadsChangesNoSample) {
+  std::string why;
+  if (!gpu_available(&why)) GTEST_SKIP() << "no usable GPU: " << why;
+  DensityGrid g = testing::cube(16, 1.0f);
+  for (size_t i = 0; i < g.tau_v.size(); ++i) g.tau_v[i] = 0.4f * philox_uniform4(9, 0, uint32_t(i), 3, 0).u0;
+  TruthInputs in;
+  in.density = &g;
+  in.bands = {TruthBand{{"B", 1.3f, 0.6f, 0.6f}, nullptr}, TruthBand{{"V", 1.0f, 0.9f, 0.3f}, nullptr}};
+  in.stars = {StarLight{{0.05f, 0.02f, 0.01f}, {1e3f, 8e2f}}};
+  CameraSettings cs;
+  cs.projection = Projection::Orthographic;
+  cs.position = {0, 0, -10};
+  cs.look_at = {0, 0, 0};
+  cs.up = {0, 1, 0};
+  cs.ortho_width = 2.2f;
+  cs.width = 24;
+  cs.height = 20;
+  in.camera = make_camera(cs);
+  in.spp = 96;
+  in.equiangular = true;
+  in.gpu_threads_per_pixel = 1;
+  const TruthOutput one = render_truth_cuda(in);
+  double total = 0;
+  for (float v : one.image.pixels) total += v;
+  EXPECT_GT(total, 0.0);
+  for (int shares : {7, 96, 0}) {  // uneven, one sample each, as many as fill the GPU
+    in.gpu_threads_per_pixel = shares;
+    const TruthOutput many = render_truth_cuda(in);
+    ASSERT_EQ(many.image.pixels.size(), one.image.pixels.size());
+    for (size_t i = 0; i < one.image.pixels.size(); ++i) {
+      EXPECT_NEAR(many.image.pixels[i], one.image.pixels[i], 1e-5f * one.image.pixels[i]) << "shares " << shares;
+      EXPECT_NEAR(many.variance.pixels[i], one.variance.pixels[i], 1e-4f * one.variance.pixels[i] + 1e-30f)
+          << "shares " << shares;
+    }
+    EXPECT_EQ(many.paths, one.paths);
+    EXPECT_EQ(many.counters.vertices, one.counters.vertices);
+  }
+}
+
 TEST(TruthGpu, CpuAndCudaAgreeWithinTheirNoise) { expect_cpu_and_cuda_agree(false); }
 TEST(TruthGpu, CpuAndCudaAgreeWithinTheirNoiseEquiangular) { expect_cpu_and_cuda_agree(true); }
 

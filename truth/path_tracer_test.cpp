@@ -422,6 +422,47 @@ TEST(PathTracer, SameSeedSameImageAndNoNaN) {
   EXPECT_NE(render_truth_cpu(in).image.pixels, a.image.pixels);
 }
 
+// A pixel's samples split into shares (as the GPU launch splits a small
+// image's) are the same samples: the shares' sums add up to the whole range's,
+// to the rounding of the double sums, with strata (pixel-area sampling) too.
+TEST(PathTracer, SplittingAPixelsSamplesKeepsEverySample) {
+  DensityGrid g = noise_grid(10, 1.0f, 2.0f, 43);
+  TruthInputs in;
+  in.density = &g;
+  in.bands = {TruthBand{{"B", 1.3f, 0.7f, 0.8f}, nullptr}, TruthBand{{"V", 1.0f, 0.9f, 0.3f}, nullptr}};
+  in.stars = {StarLight{{0.05f, 0.02f, 0.01f}, {100.0f, 80.0f}}};
+  in.camera = telescope(6, 2.2f);
+  in.spp = 36;
+  in.equiangular = true;
+  for (int side : {1, 3}) {
+    in.pixel_side = side;
+    const HostPathScene h = prepare_path_scene(in);
+    for (int y = 0; y < 6; ++y)
+      for (int x = 0; x < 6; ++x) {
+        PathCounters c;
+        PixelSums whole, parts[3];
+        trace_pixel_samples(h.scene, in.camera, x, y, 0, in.spp, whole, c);
+        const int cut[4] = {0, 5, 22, in.spp};  // uneven shares
+        for (int k = 0; k < 3; ++k) trace_pixel_samples(h.scene, in.camera, x, y, cut[k], cut[k + 1], parts[k], c);
+        for (int b = 0; b < 2; ++b) {
+          const double sum = parts[0].sum[b] + parts[1].sum[b] + parts[2].sum[b];
+          const double sum2 = parts[0].sum2[b] + parts[1].sum2[b] + parts[2].sum2[b];
+          EXPECT_NEAR(sum, whole.sum[b], 1e-12 * std::fabs(whole.sum[b])) << "pixel " << x << "," << y;
+          EXPECT_NEAR(sum2, whole.sum2[b], 1e-12 * std::fabs(whole.sum2[b])) << "pixel " << x << "," << y;
+        }
+        float mean[kMaxBands], var[kMaxBands], m2[kMaxBands], v2[kMaxBands];
+        trace_pixel(h.scene, in.camera, in.exposure, x, y, in.spp, mean, var, c);
+        pixel_moments(whole, 2, in.spp, in.exposure, m2, v2);
+        for (int b = 0; b < 2; ++b) {
+          EXPECT_EQ(mean[b], m2[b]);
+          EXPECT_EQ(var[b], v2[b]);
+        }
+      }
+    // Not a vacuous comparison: the pixels hold light.
+    EXPECT_GT(render_truth_cpu(in).image.pixels[size_t(2 * 6 + 3)], 0.0f);
+  }
+}
+
 // A camera inside the cloud (perspective and fisheye) next to a star inside
 // dust: finite, non-negative pixels; the 1/r^2 of a collision near the star
 // is a large but finite sample.

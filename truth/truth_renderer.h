@@ -1,7 +1,8 @@
 #pragma once
 // The ground-truth image of a scene: path_tracer.h per pixel, on the CPU
-// (TBB, one task per row) or the GPU (one CUDA thread per pixel), with the
-// variance of every pixel's mean beside the image.
+// (TBB, one task per row) or the GPU (one CUDA thread per pixel, or several
+// sharing its samples when the image is small), with the variance of every
+// pixel's mean beside the image.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -39,6 +40,10 @@ struct TruthInputs {
   bool exact_transmittance = false;  // NEE transmittance by the exact voxel sum (no noise) instead of ratio tracking
   bool equiangular = false;  // NEE also from equiangular samples towards each star (MIS): stars inside dust
   Progress* progress = nullptr;  // advanced in image rows (CPU); may be null
+  // CUDA: how many threads share each pixel's samples (0: as many as fill the
+  // GPU with threads; a 64 x 64 image has too few pixels for one each).
+  // Changes only the order of the double sums, never a sample.
+  int gpu_threads_per_pixel = 0;
 };
 
 struct TruthOutput {
@@ -46,6 +51,7 @@ struct TruthOutput {
   Image variance;  // variance of that mean, same layout
   double seconds = 0;  // tracing only (CUDA events on the GPU)
   uint64_t paths = 0;  // pixels with a ray x spp x bands
+  int threads_per_pixel = 1;  // how many threads shared each pixel's samples (CUDA; 1 on the CPU)
   PathCounters counters;
 };
 

@@ -280,7 +280,7 @@ PyramidBench bench_pyramid(Backend backend, int size, int width, int height, int
 namespace nebula {
 
 TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int spp, int repeats,
-                          bool exact_transmittance, bool equiangular) {
+                          bool exact_transmittance, bool equiangular, int threads_per_pixel) {
   const BenchNebula nebula(backend, size, width, height, false);
   TruthInputs in;
   in.density = &nebula.grid;
@@ -291,6 +291,7 @@ TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int 
   in.spp = spp;
   in.exact_transmittance = exact_transmittance;
   in.equiangular = equiangular;
+  in.gpu_threads_per_pixel = threads_per_pixel;
   TruthOutput out = render_truth(in, backend);  // warm-up
   std::vector<double> times;
   for (int i = 0; i < repeats; ++i) {
@@ -309,6 +310,7 @@ TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int 
   row.paths_per_second = out.paths / row.median_seconds;
   row.spp_per_second = spp / row.median_seconds;
   row.vertices_per_path = out.paths ? double(out.counters.vertices) / out.paths : 0;
+  row.threads_per_pixel = out.threads_per_pixel;
   return row;
 }
 

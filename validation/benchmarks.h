@@ -109,6 +109,7 @@ struct TruthBenchRow {
   double paths_per_second = 0;    // one path per pixel, sample and band
   double spp_per_second = 0;      // samples per pixel (all three bands) per second at width x height
   double vertices_per_path = 0;
+  int threads_per_pixel = 1;      // GPU threads sharing each pixel's samples
 };
 
 // The path tracer on the procedural nebula (as bench_render: default
@@ -116,7 +117,7 @@ struct TruthBenchRow {
 // a = g = 0.6; one warm-up, then `repeats` timed runs at `spp`. Next-event
 // transmittance by ratio tracking, or by the exact voxel sum.
 TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int spp, int repeats,
-                          bool exact_transmittance = false, bool equiangular = false);
+                          bool exact_transmittance = false, bool equiangular = false, int threads_per_pixel = 0);
 
 }  // namespace nebula
 

@@ -46,11 +46,13 @@ def study_arguments(description, work, out, scenes):
 
 
 def prepare_work(args):
-    """The work folder with validation/scenes in it, and the layer and wedge grids where asked for."""
+    """The work folder with validation/scenes in it, and the layer and wedge grids where asked for (kept when
+    already there, so a machine without h5py can run the study in a folder prepared elsewhere)."""
     os.makedirs(args.work, exist_ok=True)
     for f in os.listdir(os.path.join(ROOT, "validation", "scenes")):
         shutil.copy(os.path.join(ROOT, "validation", "scenes", f), args.work)
-    if any(s.startswith(("layer", "wedge")) for s in args.scenes.split(",")):
+    made = all(os.path.exists(os.path.join(args.work, f)) for f in ("layers.h5", "wedge.h5"))
+    if not made and any(s.startswith(("layer", "wedge")) for s in args.scenes.split(",")):
         sys.path.insert(0, os.path.join(ROOT, "validation"))
         from accuracy_report import write_densities  # numpy, h5py
         write_densities(args.work)
