@@ -71,13 +71,16 @@ namespace {
 // The 3D field's harmonics averaged over the ring of 2D cell (cx, cr): points
 // on a 2 x 2 grid in (x, r) and enough azimuths to visit every 3D cell the
 // ring crosses twice, weighted by r (the ring's volume), each turned into its
-// meridian's frame.
+// meridian's frame. The zonal blocks after the harmonics (degrees about the
+// line from a star on the axis: the same in every meridian) are averaged as
+// they are.
 void ring_average(const DiffuseField& f3, const std::vector<float>& c3, int cx, int cr, float edge, float* out) {
   const int n = f3.n_coeffs();
   const GridShape& c = f3.cells;
   std::fill(out, out + n, 0.0f);
-  double sum[kMaxShCoeffs] = {}, weight = 0;
-  float turned[kMaxShCoeffs];
+  std::vector<double> sum(static_cast<size_t>(n), 0.0);  // harmonics, then zonal blocks: more than kMaxShCoeffs
+  std::vector<float> turned(static_cast<size_t>(n));
+  double weight = 0;
   constexpr int kSub = 2;
   for (int j = 0; j < kSub; ++j) {
     const float r = (cr + (j + 0.5f) / kSub) * edge;
@@ -91,7 +94,9 @@ void ring_average(const DiffuseField& f3, const std::vector<float>& c3, int cx, 
         const int dims[3] = {c.nx, c.ny, c.nz};
         for (int a = 0; a < 3; ++a)
           ijk[a] = std::clamp(int(std::floor((detail::axis(p, a) - detail::axis(c.origin, a)) / c.voxel)), 0, dims[a] - 1);
-        sh_rotate_z(f3.degree, cp, sp, &c3[c.index(ijk[0], ijk[1], ijk[2]) * size_t(n)], turned);
+        const float* from = &c3[c.index(ijk[0], ijk[1], ijk[2]) * size_t(n)];
+        sh_rotate_z(f3.degree, cp, sp, from, turned.data());
+        for (int q = sh_count(f3.degree); q < n; ++q) turned[q] = from[q];
         const double w = r / n_phi;
         for (int q = 0; q < n; ++q) sum[q] += w * turned[q];
         weight += w;
@@ -126,14 +131,13 @@ DiffuseField bake_axial_diffuse(const AxialMap& map, const std::vector<DiffuseBa
   const DensityGrid grid = voxelize_axial_frame(map, voxel);
   AxialDiffuseStats st;
   st.grid = grid.shape;
-  // Harmonics only: the ring averages below keep (x, r) cells of harmonics,
-  // not the zonal degrees about each cell's direction from the star.
-  DiffuseBakeOptions harmonics = options;
-  harmonics.zonal = 0;
-  const DiffuseField f3 = bake_diffuse(grid, bands, local, harmonics, backend, &st.bake, progress);
+  const DiffuseField f3 = bake_diffuse(grid, bands, local, options, backend, &st.bake, progress);
 
   DiffuseField f;
   f.degree = f3.degree;
+  f.zonal = f3.zonal;
+  f.zonal_stars = f3.zonal_stars;
+  for (int k = 0; k < f3.zonal_stars; ++k) f.zonal_star[k] = map.origin + f3.zonal_star[k].z * map.axis;  // back to the world
   f.shift = 0;
   const float edge = f3.cells.voxel;
   f.cells.voxel = edge;

@@ -141,11 +141,22 @@ TEST(AxialDiffuse, ConservesEnergyAtAlbedoOne) {
 // way would move the forward-scattered light to the wrong side of the star.
 // Bounds from the discretisation differences of the single-scattering
 // comparison (axial_renderer_test.cpp: relative L1 0.15, flux 8%).
-TEST(AxialDiffuse, MatchesTheGridFieldOnTheVoxelizedMap) {
+//
+// At g = 0.9 both fields carry zonal degrees to 24 about the line from the
+// star (degree 3 below them, as "auto" resolves there): the axial map's are
+// ring averages of the 3D cells' zonal sums, evaluated per sample about the
+// same line; the grid's per voxel, at its centre. The two discretisations
+// differ more at g = 0.9, where the light is peaked within some 6 degrees:
+// with the harmonics alone by relative L1 0.13 and 0.17, flux +3% and +8%;
+// with the zonal degrees 0.20 and 0.12, flux -9% and -4% (2026-11-27).
+// Bounds there: L1 < 0.25, flux within 12%. A zonal response about a wrong
+// point (the star moved to 0.3 of its distance along the axis) gives L1 0.65
+// and 0.53: the test tells it.
+void expect_axial_field_matches_grid_field(float g_dust, int degree, int zonal, double max_l1, double max_flux) {
   for (const std::string name : {"cloud", "shells"}) {
     testing::AxialScene s(name, 48, 16, normalize(Vec3{1, 2, 3}), 50.0f, 1.0f);
-    s.table = thin_table(0.6);
-    for (auto& b : s.inputs.bands) b.g = 0.6f;
+    s.table = thin_table(g_dust);
+    for (auto& b : s.inputs.bands) b.g = g_dust;
     s.inputs.step = 0.25f * s.map.texel;
     s.inputs.camera = s.view(60, 48, 0);
     const StarLight star{s.inputs.stars[0].position, s.inputs.stars[0].power};
@@ -154,8 +165,13 @@ TEST(AxialDiffuse, MatchesTheGridFieldOnTheVoxelizedMap) {
     DiffuseBakeOptions o;
     o.photons = 1u << 18;
     o.cells = 24;
+    o.degree = degree;
+    o.zonal = zonal;
     const Image axial0 = render_axial_cpu(s.inputs, nullptr);
     const DiffuseField axial_field = bake_axial_diffuse(s.map, bands, {star}, o, Backend::Cpu);
+    ASSERT_EQ(axial_field.n_zonal(), zonal > 0 ? zonal - degree : 0);
+    ASSERT_EQ(axial_field.zonal_stars, zonal > 0 ? 1 : 0);
+    if (zonal > 0) EXPECT_LT(length(axial_field.zonal_star[0] - star.position), 1e-4f) << "the star, in the world";
     s.inputs.diffuse = &axial_field;
     const Image axial1 = render_axial_cpu(s.inputs, nullptr);
 
@@ -183,12 +199,18 @@ TEST(AxialDiffuse, MatchesTheGridFieldOnTheVoxelizedMap) {
       flux_single += axial0.pixels[i];
     }
     const double err = testing::relative_l1(a, g);
-    std::printf("%s: the field's light, axial vs grid: relative L1 %.4f, flux ratio %.4f (%.1f%% of single scattering)\n",
-                name.c_str(), err, flux_a / flux_g, 100 * flux_a / flux_single);
+    std::printf("g %.1f zonal %d, %s: the field's light, axial vs grid: relative L1 %.4f, flux ratio %.4f "
+                "(%.1f%% of single scattering)\n",
+                g_dust, zonal, name.c_str(), err, flux_a / flux_g, 100 * flux_a / flux_single);
     EXPECT_GT(flux_a, 0.1 * flux_single) << "the scene must have a field worth testing";
-    EXPECT_LT(err, 0.15) << name;
-    EXPECT_NEAR(flux_a / flux_g, 1.0, 0.08) << name;
+    EXPECT_LT(err, max_l1) << name;
+    EXPECT_NEAR(flux_a / flux_g, 1.0, max_flux) << name;
   }
+}
+
+TEST(AxialDiffuse, MatchesTheGridFieldOnTheVoxelizedMap) { expect_axial_field_matches_grid_field(0.6f, 3, 0, 0.15, 0.08); }
+TEST(AxialDiffuse, ZonalDegreesMatchTheGridFieldsOnTheVoxelizedMap) {
+  expect_axial_field_matches_grid_field(0.9f, 3, 24, 0.25, 0.12);
 }
 
 }  // namespace

@@ -25,6 +25,7 @@
 #include "axial/axial_map.h"
 #include "core/hd.h"
 #include "core/vec3.h"
+#include "diffuse/zonal_light.h"
 #include "illumination/chord_irradiance.h"
 #include "illumination/optical_depth_bake.h"
 #include "raycast/ray_march.h"
@@ -55,6 +56,12 @@ enum class AxialSkip : int {
 
 const char* to_string(AxialSkip mode);
 
+// The light scattered between cells a march adds: none, the field's
+// harmonics, or the harmonics with zonal degrees (DiffuseView::zonal > 0). A
+// kernel of its own each: the zonal code in the harmonics' kernel doubled
+// its frame times (H200: 22.4 -> 42.9 ms on the lopsided map).
+enum class AxialField : int { None = 0, Harmonics = 1, Zonal = 2 };
+
 struct AxialMarchScene {
   AxialView map;
   int n_bands = 0;
@@ -77,8 +84,10 @@ struct AxialMarchScene {
 // the eye per band, per unit of chord / l, added to `source`; its forward
 // peak per band into `peak`. The field is kept in each meridian's frame (x'
 // away from the axis, y' around it, z' along it), so the way to the eye is
-// turned into that frame first. Evaluated per sample: unlike the grid's
+// turned into that frame first; its zonal degrees (g >= 0.8 by default) are
+// about the line from each star, the same in every frame. Evaluated per sample: unlike the grid's
 // voxels, a texel is a ring and meets the eye from every side.
+template <bool kZonal>
 NEBULA_HD void add_axial_diffuse_light(const AxialMarchScene& s, Vec3 q, float x, float r, float tau_v, Vec3 to_eye,
                                        float* source, float* peak) {
   const AxialView& m = s.map;
@@ -96,7 +105,24 @@ NEBULA_HD void add_axial_diffuse_light(const AxialMarchScene& s, Vec3 q, float x
   cx = cx < 0 ? 0 : (cx >= f.cells.nx ? f.cells.nx - 1 : cx);
   cr = cr >= f.cells.ny ? f.cells.ny - 1 : cr;
   float D[kMaxBands][kMaxDiffuseDegree + 1];
-  f.project<kMaxDiffuseDegree>(f.cells.index(cx, cr, 0), local, D, f.degree);
+  const size_t cell = f.cells.index(cx, cr, 0);
+  f.project<kMaxDiffuseDegree>(cell, local, D, f.degree);
+  if constexpr (kZonal) {
+    // The zonal degrees about the direction from each zonal star (on the
+    // axis): a scalar per (x, r) cell, the same in every meridian's frame,
+    // so the world's directions serve (m.origin + q is the sample's point).
+    float light[kMaxBands] = {}, zonal_peak[kMaxBands] = {};
+    if (zonal_scattered_light<kMaxDiffuseDegree>(s, f, tau_v, cell, m.origin + q, to_eye, D, light, zonal_peak,
+                                                 f.degree)) {
+      NEBULA_UNROLL
+      for (int b = 0; b < kMaxBands; ++b)
+        if (b < s.n_bands && f.has[b]) {
+          source[b] += light[b];
+          peak[b] = zonal_peak[b];
+        }
+      return;
+    }
+  }
   NEBULA_UNROLL
   for (int b = 0; b < kMaxBands; ++b)
     if (b < s.n_bands && f.has[b]) {
@@ -286,8 +312,8 @@ NEBULA_HD int thesis_omega_max(const AxialView& m, const AxialRay& ray, int ix, 
 }  // namespace axial_detail
 
 // One ray through the axial map: radiance and transmittance per band. The
-// skip mode (s.skip is not read), whether there are stars, whether there is a
-// diffuse field (s.has_diffuse is not read) and whether the scene has
+// skip mode (s.skip is not read), whether there are stars, the diffuse field's
+// kind (s.has_diffuse and s.diffuse.zonal are not read) and whether the scene has
 // deformations (kDeform; which ones: s.deform) are fixed at compile time, so
 // each kernel holds only what its scene needs (a scene without stars carries
 // no table lookups in its registers). With the field, its light adds to the
@@ -302,8 +328,9 @@ NEBULA_HD int thesis_omega_max(const AxialView& m, const AxialRay& ray, int ix, 
 // its upper end, the distance jump the distance map at its middle less half
 // its width. The colour factors only lower a non-empty texel's values, so
 // they change no proof.
-template <AxialSkip kMode, bool kStars, bool kDiffuse = false, bool kDeform = false>
+template <AxialSkip kMode, bool kStars, AxialField kField = AxialField::None, bool kDeform = false>
 NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 dir, int* visited = nullptr) {
+  constexpr bool kDiffuse = kField != AxialField::None;
   RayResult out{};
   for (int b = 0; b < kMaxBands; ++b) out.transmittance[b] = 1.0f;
   const AxialView& m = s.map;
@@ -436,7 +463,7 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
                            tau_v, to_eye, source, &out.table_clamps);
         }
         if constexpr (kDiffuse)
-          if (tau_v > 0.0f) add_axial_diffuse_light(s, q, x, r, tau_v, to_eye, source, peak);
+          if (tau_v > 0.0f) add_axial_diffuse_light<kField == AxialField::Zonal>(s, q, x, r, tau_v, to_eye, source, peak);
         if constexpr (kDeform)
           if (deform.colour && !dark) {
             colour_factors(deform, q, s.n_bands, lower);
@@ -553,21 +580,31 @@ NEBULA_HD RayResult march_axial_ray(const AxialMarchScene& s, Vec3 origin, Vec3 
   return out;
 }
 
-// Calls f(mode, stars, diffuse, deform) with std::integral_constant /
-// std::bool_constant for the run-time mode, whether the scene has stars,
-// whether it has a diffuse field (only with stars) and whether it has
-// deformations: the one place that turns them into template arguments (the
-// CPU loop, the CUDA launch).
+// The field a scene's march adds (the kernel to run).
+NEBULA_HD AxialField axial_field(const AxialMarchScene& s) {
+  if (!s.has_diffuse) return AxialField::None;
+  return s.diffuse.zonal > 0 ? AxialField::Zonal : AxialField::Harmonics;
+}
+
+// Calls f(mode, stars, field, deform) with std::integral_constant /
+// std::bool_constant for the run-time mode, whether the scene has stars, its
+// diffuse field's kind (only with stars) and whether it has deformations: the
+// one place that turns them into template arguments (the CPU loop, the CUDA
+// launch).
 template <class F>
-decltype(auto) dispatch_axial(AxialSkip mode, bool stars, bool diffuse, bool deform, F&& f) {
+decltype(auto) dispatch_axial(AxialSkip mode, bool stars, AxialField field, bool deform, F&& f) {
   auto with_deform = [&](auto m, auto st, auto di) -> decltype(auto) {
     if (deform) return f(m, st, di, std::true_type{});
     return f(m, st, di, std::false_type{});
   };
+  using None = std::integral_constant<AxialField, AxialField::None>;
   auto with_stars = [&](auto m) -> decltype(auto) {
-    if (!stars) return with_deform(m, std::false_type{}, std::false_type{});
-    return diffuse ? with_deform(m, std::true_type{}, std::true_type{})
-                   : with_deform(m, std::true_type{}, std::false_type{});
+    if (!stars) return with_deform(m, std::false_type{}, None{});
+    if (field == AxialField::Zonal)
+      return with_deform(m, std::true_type{}, std::integral_constant<AxialField, AxialField::Zonal>{});
+    if (field == AxialField::Harmonics)
+      return with_deform(m, std::true_type{}, std::integral_constant<AxialField, AxialField::Harmonics>{});
+    return with_deform(m, std::true_type{}, None{});
   };
   switch (mode) {
     case AxialSkip::Naive: return with_stars(std::integral_constant<AxialSkip, AxialSkip::Naive>{});

@@ -98,8 +98,8 @@ Image render_axial_cpu(const AxialRenderInputs& in, AxialRenderStats* stats) {
   Image image(in.camera.width, in.camera.height, band_names(in.bands));
   std::atomic<uint64_t> clamps{0}, reads{0};
   const auto start = std::chrono::steady_clock::now();
-  dispatch_axial(scene.skip, scene.n_stars > 0, scene.has_diffuse, in.deform.any(),
-                 [&](auto mode, auto has_stars, auto diffuse, auto deform) {
+  dispatch_axial(scene.skip, scene.n_stars > 0, axial_field(scene), in.deform.any(),
+                 [&](auto mode, auto has_stars, auto field, auto deform) {
     tbb::parallel_for(tbb::blocked_range<int>(0, in.camera.height), [&](const auto& rows) {
       uint64_t local = 0, local_reads = 0;
       for (int y = rows.begin(); y != rows.end(); ++y)
@@ -108,7 +108,7 @@ Image render_axial_cpu(const AxialRenderInputs& in, AxialRenderStats* stats) {
           if (!in.camera.ray(x, y, origin, dir)) continue;
           int visited = 0;
           const RayResult r =
-              march_axial_ray<decltype(mode)::value, decltype(has_stars)::value, decltype(diffuse)::value,
+              march_axial_ray<decltype(mode)::value, decltype(has_stars)::value, decltype(field)::value,
                               decltype(deform)::value>(scene, origin, dir, &visited);
           local_reads += uint64_t(visited);
           store_radiance(r, scene.n_bands, in.exposure, image.pixels.data(), image.width, image.height, x, y);

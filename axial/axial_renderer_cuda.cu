@@ -23,10 +23,10 @@ namespace {
 #define NEBULA_AXIAL_MIN_BLOCKS 3  // with the band loops unrolled, at most 80 registers: 15-35% faster (H100, docs/performance.md)
 #endif
 
-// One instantiation per skip mode, star use, diffuse field and deformation use: each kernel holds only its
+// One instantiation per skip mode, star use, diffuse field kind and deformation use: each kernel holds only its
 // mode's checks and gets its own register allocation; the physics is the
 // same template.
-template <AxialSkip kMode, bool kStars, bool kDiffuse, bool kDeform>
+template <AxialSkip kMode, bool kStars, AxialField kField, bool kDeform>
 __global__ void __launch_bounds__(256, NEBULA_AXIAL_MIN_BLOCKS)
     axial_kernel(AxialMarchScene scene, Camera camera, float exposure, float* pixels, unsigned long long* clamps) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x;
@@ -34,7 +34,7 @@ __global__ void __launch_bounds__(256, NEBULA_AXIAL_MIN_BLOCKS)
   if (x >= camera.width || y >= camera.height) return;
   Vec3 origin, dir;
   if (!camera.ray(x, y, origin, dir)) return;
-  const RayResult r = march_axial_ray<kMode, kStars, kDiffuse, kDeform>(scene, origin, dir);
+  const RayResult r = march_axial_ray<kMode, kStars, kField, kDeform>(scene, origin, dir);
   store_radiance(r, scene.n_bands, exposure, pixels, camera.width, camera.height, x, y);
   if (r.table_clamps) atomicAdd(clamps, static_cast<unsigned long long>(r.table_clamps));
 }
@@ -56,9 +56,9 @@ Image render_axial_cuda(const AxialRenderInputs& in, AxialRenderStats* stats) {
   constexpr int bx = NEBULA_AXIAL_BLOCK_X, by = 128 / bx;
   const dim3 block(bx, by), grid((in.camera.width + bx - 1) / bx, (in.camera.height + by - 1) / by);
   CudaEventTimer timer;
-  dispatch_axial(scene.skip, scene.n_stars > 0, scene.has_diffuse, in.deform.any(),
-                 [&](auto mode, auto has_stars, auto diffuse, auto deform) {
-    axial_kernel<decltype(mode)::value, decltype(has_stars)::value, decltype(diffuse)::value, decltype(deform)::value>
+  dispatch_axial(scene.skip, scene.n_stars > 0, axial_field(scene), in.deform.any(),
+                 [&](auto mode, auto has_stars, auto field, auto deform) {
+    axial_kernel<decltype(mode)::value, decltype(has_stars)::value, decltype(field)::value, decltype(deform)::value>
         <<<grid, block>>>(scene, in.camera, in.exposure, pixels.get(), clamps.get());
   });
   NEBULA_CUDA_CHECK(cudaGetLastError());

@@ -134,9 +134,11 @@ TEST(AxialRendererGpu, DeformedMarchMatchesTheCpu) {
 // fraction of its noise (the photons' paths differ by float contraction, as
 // in diffuse_gpu_tests; the ring averages run on the host), and the march
 // with it follows the CPU's with the bounds above, in the skipping modes.
+// With zonal degrees (to 24 above degree 3) as without.
 TEST(AxialRendererGpu, DiffuseFieldMatchesTheCpu) {
   std::string why;
   if (!gpu_available(&why)) GTEST_SKIP() << why;
+  for (const int zonal : {0, 24})
   for (const std::string name : {"cloud", "bipolar"}) {
     AxialScene s(name, 96, 40, normalize(Vec3{1, 2, 3}), 50.0f, 1.0f);
     std::vector<DiffuseBand> bands;
@@ -149,6 +151,8 @@ TEST(AxialRendererGpu, DiffuseFieldMatchesTheCpu) {
     DiffuseBakeOptions o;
     o.photons = 1u << 16;
     o.cells = 24;
+    o.degree = 3;
+    o.zonal = zonal;
     const StarLight star{s.inputs.stars[0].position, s.inputs.stars[0].power};
     AxialDiffuseStats cpu_stats;
     const DiffuseField cpu_field = bake_axial_diffuse(s.map, bands, {star}, o, Backend::Cpu, &cpu_stats);
@@ -160,8 +164,9 @@ TEST(AxialRendererGpu, DiffuseFieldMatchesTheCpu) {
       norm += std::pow(double(cpu_field.host_packed()[i]), 2);
     }
     const double rel = std::sqrt(diff / norm);
-    std::printf("%s: axial field CPU-GPU relative L2 difference %.3g (one 3D cell's noise %.3g)\n", name.c_str(), rel,
-                cpu_stats.bake.noise[1]);
+    std::printf("%s, zonal %d: axial field CPU-GPU relative L2 difference %.3g (one 3D cell's noise %.3g)\n",
+                name.c_str(), zonal, rel, cpu_stats.bake.noise[1]);
+    ASSERT_EQ(gpu_field.n_zonal(), zonal > 0 ? zonal - 3 : 0);
     EXPECT_LT(rel, 0.25 * cpu_stats.bake.noise[1]) << name;
     s.inputs.diffuse = &cpu_field;
     for (int inc : {30, 90}) {
@@ -170,8 +175,9 @@ TEST(AxialRendererGpu, DiffuseFieldMatchesTheCpu) {
       const Image cpu = render_axial_cpu(s.inputs, nullptr);
       const Image naive = render_axial_cuda(s.inputs, nullptr);
       const Difference c = compare(naive, cpu);
-      std::printf("%s %d deg with the diffuse field: GPU-CPU largest %.3g, mean %.3g of the peak; %.3g%% of pixels > 1e-4\n",
-                  name.c_str(), inc, c.worst / c.peak, c.mean / c.peak, 100 * c.flipped);
+      std::printf("%s %d deg with the diffuse field (zonal %d): GPU-CPU largest %.3g, mean %.3g of the peak; %.3g%% of "
+                  "pixels > 1e-4\n",
+                  name.c_str(), inc, zonal, c.worst / c.peak, c.mean / c.peak, 100 * c.flipped);
       EXPECT_LE(c.flipped, 0.01) << name << " " << inc;
       EXPECT_LE(c.mean, 1e-4 * c.peak) << name << " " << inc;
       EXPECT_LE(c.worst, 0.25 * c.peak) << name << " " << inc;
