@@ -36,6 +36,10 @@ def study_arguments(description, work, out, scenes):
     ap.add_argument("--backend", default="auto")
     ap.add_argument("--work", default=work)
     ap.add_argument("--spp", type=int, default=512, help="truth samples per pixel")
+    ap.add_argument("--truth-strata", type=int, default=1,
+                    help="the truth's pixel-area strata per side (render.samples_per_pixel = this squared, for the "
+                         "truth only; 1: each pixel's centre ray, as the fast renderer traces); spp must be a multiple "
+                         "of its square")
     ap.add_argument("--fig12-pixels", type=int, default=128, help="image size of the Fig. 12 scene")
     ap.add_argument("--albedos", default="0.3,0.6,0.9")
     ap.add_argument("--gs", default="0,0.6,0.9")
@@ -70,8 +74,9 @@ def truth_grid(runner, args, scene, truth_scene):
             tag = f"{scene}_a{a}_g{g}"
             truth = os.path.join(args.work, f"truth_{tag}.h5")
             t0 = time.time()
+            strata = ["--set", f"render.samples_per_pixel={args.truth_strata ** 2}"] if args.truth_strata > 1 else []
             runner.run(["truth", truth_scene, "--spp", str(args.spp), "--equiangular", "--backend", runner.backend,
-                        "-q", "--force", "-o", truth] + shared)
+                        "-q", "--force", "-o", truth] + shared + strata)
             yield a, g, shared, tag, truth, time.time() - t0
 
 
