@@ -64,15 +64,17 @@ inline Camera oblique_camera(int width, int height) {
   return make_camera(cs);
 }
 
-// An orthographic camera on the -z axis looking at the origin, `width` wide.
-inline Camera telescope(int pixels, float width) {
+// An orthographic camera on the -z axis looking at the origin, `width` wide;
+// pixels x pixels, or pixels x height where height > 0.
+inline Camera telescope(int pixels, float width, int height = 0) {
   CameraSettings s;
   s.projection = Projection::Orthographic;
   s.position = {0, 0, -10};
   s.look_at = {0, 0, 0};
   s.up = {0, 1, 0};
   s.ortho_width = width;
-  s.width = s.height = pixels;
+  s.width = pixels;
+  s.height = height > 0 ? height : pixels;
   return make_camera(s);
 }
 // One band, one star: everything render() needs, owning the pieces.

@@ -50,6 +50,8 @@ def main():
     ap.add_argument("--merge", default="", help="comma-separated JSON rows of earlier runs (e.g. one per group of "
                     "scenes, each within a device call's time): write the page from them, render nothing")
     args = ap.parse_args()
+    if args.truth_strata < 1:
+        raise SystemExit(f"--truth-strata: must be 1 or more, got {args.truth_strata}")
     if args.merge:
         return merge(args)
     prepare_work(args)
@@ -85,8 +87,14 @@ def main():
 def merge(args):
     rows = []
     for path in args.merge.split(","):
-        with open(path) as f:
-            rows += json.load(f)
+        try:
+            with open(path) as f:
+                part = json.load(f)
+        except (OSError, ValueError) as e:
+            raise SystemExit(f"--merge: {path}: cannot read the study's JSON rows ({e})")
+        if not isinstance(part, list) or not all(isinstance(r, dict) and "scene" in r and "method" in r for r in part):
+            raise SystemExit(f"--merge: {path}: not a study's JSON rows (a list of rows with scene and method)")
+        rows += part
     methods = [m for m in METHODS if any(r["method"] == m for r in rows)]
     albedos = sorted({r["albedo"] for r in rows})
     gs = sorted({r["g"] for r in rows})
