@@ -184,6 +184,7 @@ void expect_axial_field_matches_grid_field(float g_dust, int degree, int zonal, 
       in.bands.push_back(RenderBand{s.inputs.bands[b], &s.table, nullptr});
     in.stars.push_back(BakedStar{star, &depth});
     in.camera = s.inputs.camera;
+    in.star_pixels = s.inputs.star_pixels;  // one ray per pixel, as the axial scene's
     const Image grid0 = render_cpu(in, nullptr);
     const DiffuseField grid_field = bake_diffuse(grid, bands, {star}, o, Backend::Cpu);
     in.diffuse = &grid_field;

@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "core/placement.h"
 #include "core/progress.h"
+#include "illumination/star_pixels_cpu.h"
 
 namespace nebula {
 
@@ -118,6 +119,20 @@ Image render_axial_cpu(const AxialRenderInputs& in, AxialRenderStats* stats) {
       reads += local_reads;
       if (in.progress) in.progress->add(rows.size());
     });
+    if constexpr (decltype(has_stars)::value) {
+      // The pixels at each star's image, with many rays each (illumination/star_pixels.h).
+      if (in.star_pixels)
+      march_star_pixels_cpu(in.camera, star_positions(in.stars), scene.n_bands, in.exposure, image.pixels.data(),
+                            [&](Vec3 origin, Vec3 dir, int side, float* out, size_t stride) {
+                              AxialMarchScene sub = scene;
+                              sub.footprint = sub_pixel_footprint(scene.footprint, side);
+                              const RayResult r = march_axial_ray<decltype(mode)::value, true, decltype(field)::value,
+                                                                  decltype(deform)::value>(sub, origin, dir);
+                              for (int b = 0; b < scene.n_bands; ++b) out[size_t(b) * stride] = r.radiance[b];
+                              return uint64_t(r.table_clamps);
+                            },
+                            clamps);
+    }
   });
   if (stats) {
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -38,6 +38,7 @@ struct AxialRenderInputs {
   AxialDeformSettings deform;
   Camera camera;
   float exposure = 1.0f;
+  bool star_pixels = true;  // the pixels at each star's image with many rays each (illumination/star_pixels.h)
   float min_transmittance = 1e-4f;
   float step = 0;  // h in world units; 0 means half a texel
   AxialSkip skip = AxialSkip::Distance;

@@ -10,9 +10,11 @@
 #include "axial/axial_renderer.h"
 #include "axial/axial_scene.h"
 #include "core/cuda_check.h"
+#include "core/cuda_side_stream.h"
 #include "core/cuda_timer.h"
 #include "core/device_array.h"
 #include "core/device_placement.h"
+#include "illumination/star_pixels.h"
 
 namespace nebula {
 namespace {
@@ -39,6 +41,33 @@ __global__ void __launch_bounds__(256, NEBULA_AXIAL_MIN_BLOCKS)
   if (r.table_clamps) atomicAdd(clamps, static_cast<unsigned long long>(r.table_clamps));
 }
 
+// One thread per ray of the pixels at each star's image (raycast/star_pixels.h),
+// each standing for its sub-pixel, into sub; then averaged per pixel in order.
+template <AxialSkip kMode, AxialField kField, bool kDeform>
+__global__ void __launch_bounds__(256) axial_star_pixel_kernel(AxialMarchScene scene, Camera camera,
+                                                               const StarPixel* list, int n, int rays, float* sub,
+                                                               unsigned long long* clamps) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= rays) return;
+  const RayFootprint pixel = scene.footprint;
+  const int n_clamps = march_star_pixel_ray(camera, list, n, rays, i, kMaxBands, sub,
+                                            [&](Vec3 origin, Vec3 dir, int side, float* out, size_t stride) {
+    scene.footprint = sub_pixel_footprint(pixel, side);
+    const RayResult r = march_axial_ray<kMode, true, kField, kDeform>(scene, origin, dir);
+    for (int b = 0; b < kMaxBands; ++b) out[size_t(b) * stride] = r.radiance[b];
+    return r.table_clamps;
+  });
+  if (n_clamps) atomicAdd(clamps, static_cast<unsigned long long>(n_clamps));
+}
+
+__global__ void axial_star_pixel_store_kernel(const StarPixel* list, int n, const float* sub, int rays, int n_bands,
+                                              float exposure, float* pixels, int width, int height) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i < n) store_star_pixel(sub, size_t(rays), list[i], n_bands, exposure, pixels, width, height);
+}
+
+thread_local SideStream star_pixel_stream;  // the star pixels' rays, beside the main launch
+
 }  // namespace
 
 Image render_axial_cuda(const AxialRenderInputs& in, AxialRenderStats* stats) {
@@ -55,11 +84,37 @@ Image render_axial_cuda(const AxialRenderInputs& in, AxialRenderStats* stats) {
 #endif
   constexpr int bx = NEBULA_AXIAL_BLOCK_X, by = 128 / bx;
   const dim3 block(bx, by), grid((in.camera.width + bx - 1) / bx, (in.camera.height + by - 1) / by);
+  int rays = 0;
+  const std::vector<StarPixel> list =
+      scene.n_stars > 0 && in.star_pixels ? star_pixels(in.camera, star_positions(in.stars), &rays)
+                                          : std::vector<StarPixel>{};
+  std::unique_ptr<DeviceArray<StarPixel>> device_list;
+  std::unique_ptr<DeviceArray<float>> sub;
+  if (!list.empty()) {
+    device_list = std::make_unique<DeviceArray<StarPixel>>(list);
+    sub = std::make_unique<DeviceArray<float>>(size_t(rays) * kMaxBands);
+  }
   CudaEventTimer timer;
   dispatch_axial(scene.skip, scene.n_stars > 0, axial_field(scene), in.deform.any(),
                  [&](auto mode, auto has_stars, auto field, auto deform) {
-    axial_kernel<decltype(mode)::value, decltype(has_stars)::value, decltype(field)::value, decltype(deform)::value>
+    constexpr AxialSkip kMode = decltype(mode)::value;
+    constexpr AxialField kField = decltype(field)::value;
+    constexpr bool kDeform = decltype(deform)::value;
+    if constexpr (decltype(has_stars)::value) {
+      if (!list.empty()) {
+        star_pixel_stream.start();
+        axial_star_pixel_kernel<kMode, kField, kDeform><<<unsigned((rays + 255) / 256), 256, 0, star_pixel_stream.stream>>>(
+            scene, in.camera, device_list->get(), int(list.size()), rays, sub->get(), clamps.get());
+      }
+    }
+    axial_kernel<kMode, decltype(has_stars)::value, kField, kDeform>
         <<<grid, block>>>(scene, in.camera, in.exposure, pixels.get(), clamps.get());
+    if (!list.empty()) {
+      star_pixel_stream.join();
+      axial_star_pixel_store_kernel<<<unsigned((list.size() + 127) / 128), 128>>>(
+          device_list->get(), int(list.size()), sub->get(), rays, scene.n_bands, in.exposure, pixels.get(),
+          in.camera.width, in.camera.height);
+    }
   });
   NEBULA_CUDA_CHECK(cudaGetLastError());
   const double seconds = timer.seconds();

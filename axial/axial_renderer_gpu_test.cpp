@@ -47,6 +47,7 @@ TEST(AxialRendererGpu, SkippingModesMatchNaiveAndTheCpu) {
   if (!gpu_available(&why)) GTEST_SKIP() << why;
   for (const std::string& name : synthetic_axial_map_names()) {
     AxialScene s(name, 96, 40);
+    s.inputs.star_pixels = true;  // the star pixels' rays on both backends too
     for (int inc = 0; inc <= 90; inc += 15) {
       for (float distance : {0.0f, 6.0f}) {
         s.inputs.camera = s.view(inc, 64, distance);
@@ -91,6 +92,7 @@ TEST(AxialRendererGpu, DeformedMarchMatchesTheCpu) {
   const NoiseKind kinds[] = {NoiseKind::Simplex, NoiseKind::Fbm, NoiseKind::Turbulence, NoiseKind::Cellular};
   for (const std::string& name : synthetic_axial_map_names()) {
     AxialScene s(name, 96, 40);
+    s.inputs.star_pixels = true;  // the star pixels' rays on both backends too
     for (int k = 0; k < 4; ++k) {
       AxialDeformSettings& d = s.inputs.deform;
       d.colour = d.shape = true;
@@ -141,6 +143,7 @@ TEST(AxialRendererGpu, DiffuseFieldMatchesTheCpu) {
   for (const int zonal : {0, 24})
   for (const std::string name : {"cloud", "bipolar"}) {
     AxialScene s(name, 96, 40, normalize(Vec3{1, 2, 3}), 50.0f, 1.0f);
+    s.inputs.star_pixels = true;  // the star pixels' rays on both backends too
     std::vector<DiffuseBand> bands;
     for (const auto& b : s.inputs.bands) {
       DiffuseBand d;

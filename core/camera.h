@@ -16,10 +16,14 @@ namespace nebula {
 enum class Projection : int { Perspective = 0, Orthographic = 1, Fisheye = 2 };
 
 // A pixel's width at distance t along its ray, in world units: width_at_eye +
-// t x spread (the marchers' starlight near a star, illumination/chord_irradiance.h).
+// t x spread, and the directions of its sides (the camera's right and up; zero
+// where the pixels have no fixed sides, the fisheye's). The marchers' starlight
+// near a star takes the pixel's mean of 1/b from these
+// (illumination/chord_irradiance.h).
 struct RayFootprint {
   float width_at_eye = 0;
   float spread = 0;
+  Vec3 side_x, side_y;
   NEBULA_HD float width(float t) const { return width_at_eye + fmaxf(t, 0.0f) * spread; }
 };
 
@@ -79,9 +83,11 @@ struct Camera {
   NEBULA_HD RayFootprint footprint() const {
     const float fh = float(frame_height > 0 ? frame_height : height);
     const float per_pixel = 2.0f * pixel_span / fmaxf(fh, 1.0f);  // image units per pixel
-    if (projection == Projection::Perspective) return {0.0f, per_pixel * tan_half_fov};
-    if (projection == Projection::Orthographic) return {per_pixel * half_height, 0.0f};
-    return {0.0f, per_pixel * 0.5f * kPi};  // fisheye: 90 degrees from the centre to the rim
+    if (projection == Projection::Perspective) return {0.0f, per_pixel * tan_half_fov, right, up};
+    if (projection == Projection::Orthographic) return {per_pixel * half_height, 0.0f, right, up};
+    // Fisheye: 90 degrees from the centre to the rim; its pixels turn with the
+    // azimuth, so no fixed sides.
+    return {0.0f, per_pixel * 0.5f * kPi, {}, {}};
   }
 
   // The unit direction from `point` towards the eye along the ray that sees

@@ -9,10 +9,11 @@
 //
 // A ray stands for its pixel: the pixels around a star hold the mean of the
 // 1 / b profile of their rays' line integrals (b the ray's distance from the
-// star), which diverges on the star's own line. Softening b^2 to b^2 + w^2 / (4
-// pi), w the pixel's width at the star's distance, gives the exact mean over a
-// round pixel of the same area centred on the star (0.55% above a square
-// one's) and 1 / b far from it (docs/marcher.md).
+// star), which diverges on the star's own line. The marchers replace b by
+// 1 / (the mean of 1 / b over the square pixel around the ray, at the star's
+// distance), in closed form (pixel_mean_b2); a fisheye's pixels, with no fixed
+// sides, soften b^2 to b^2 + w^2 / (4 pi), the mean over a round pixel centred on
+// the star (docs/marcher.md).
 #include "core/camera.h"
 #include "core/hd.h"
 #include "core/math.h"
@@ -31,8 +32,46 @@ struct ChordIrradiance {
   float a0 = 0, a1 = 0;
 };
 
+// The integral of 1 / sqrt(x^2 + y^2) over [0, x] x [0, y], odd in x and in y
+// (so that a rectangle's integral is the difference of its corners'):
+// x asinh(y / x) + y asinh(x / y).
+NEBULA_HD float inverse_distance_corner(float x, float y) {
+  const float ax = fabsf(x), ay = fabsf(y);
+  float v = 0.0f;
+  if (ax > 0.0f) v += ax * asinhf(ay / ax);
+  if (ay > 0.0f) v += ay * asinhf(ax / ay);
+  return (x < 0.0f) != (y < 0.0f) ? -v : v;
+}
+
+// The mean of 1 / |(x, y) + (u, v)| over a unit square pixel, (u, v) in
+// [-1/2, 1/2]^2: 2 asinh(1) / (1/2) = 3.5255 at its centre, 1.7627 at its
+// corner, 1 / sqrt(x^2 + y^2 - 1/12) within 0.01% beyond 3 widths.
+NEBULA_HD float square_pixel_mean_inverse_distance(float x, float y) {
+  return inverse_distance_corner(x + 0.5f, y + 0.5f) - inverse_distance_corner(x - 0.5f, y + 0.5f) -
+         inverse_distance_corner(x + 0.5f, y - 0.5f) + inverse_distance_corner(x - 0.5f, y - 0.5f);
+}
+
+// b^2 for a ray whose pixel is w wide at the star, `off` the star's offset from
+// the ray (perpendicular to it): 1 / (the pixel's mean of 1 / b)^2. Beyond 4
+// widths b^2 - w^2 / 12 (within 0.003%), without the transcendentals.
+// kNearStar false: for a ray that passes no star within 4 widths
+// (passes_near_a_star, tables/chord_phase.h), whose kernel then carries none of
+// the closed form (given a star within them, it softens as a round pixel).
+template <bool kNearStar = true>
+NEBULA_HD float pixel_mean_b2(Vec3 off, float w, const RayFootprint& footprint) {
+  const float b2 = dot(off, off), w2 = w * w;
+  if (b2 >= 16.0f * w2) return b2 - w2 * (1.0f / 12.0f);
+  const bool sides = dot(footprint.side_x, footprint.side_x) > 0.0f;
+  if (!kNearStar || !sides) return b2 + w2 * kInv4Pi;
+  const float inv_w = 1.0f / w;
+  const float mean = square_pixel_mean_inverse_distance(dot(off, footprint.side_x) * inv_w,
+                                                        dot(off, footprint.side_y) * inv_w);
+  return w2 / (mean * mean);
+}
+
 // The chord from origin + t0 dir to origin + t1 dir (unit dir) of a ray with
-// this footprint, lit by a star at `star`.
+// this footprint, lit by a star at `star`. kNearStar as pixel_mean_b2's.
+template <bool kNearStar = true>
 NEBULA_HD ChordIrradiance chord_irradiance(Vec3 origin, Vec3 dir, float t0, float t1, Vec3 star,
                                            const RayFootprint& footprint) {
   ChordIrradiance out;
@@ -40,8 +79,8 @@ NEBULA_HD ChordIrradiance chord_irradiance(Vec3 origin, Vec3 dir, float t0, floa
   const float tc = dot(to_star, dir);  // the closest approach along the ray
   const Vec3 off = to_star - tc * dir;
   const float w = footprint.width(tc);
-  // b^2 + w^2 / (4 pi), never 0 (a pixel has a width; a guard for a point camera).
-  const float b2 = fmaxf(dot(off, off) + w * w * kInv4Pi, 1e-30f + 1e-12f * dot(to_star, to_star));
+  // The pixel's b^2, never 0 (a pixel has a width; a guard for a point camera).
+  const float b2 = fmaxf(pixel_mean_b2<kNearStar>(off, w, footprint), 1e-30f + 1e-12f * dot(to_star, to_star));
   const float chord = t1 - t0;
   const float mid = 0.5f * (t0 + t1) - tc;
   const float r2_mid = b2 + mid * mid;

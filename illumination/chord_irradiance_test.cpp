@@ -7,7 +7,7 @@
 namespace nebula {
 namespace {
 
-// The mean of 1 / (b^2 + w^2 / (4 pi) + s^2) over the chord by the midpoint rule on 20000 pieces.
+// The mean of 1 / (b^2 + soft2 + s^2) over the chord by the midpoint rule on 20000 pieces.
 double quadrature(Vec3 origin, Vec3 dir, double t0, double t1, Vec3 star, float soft2) {
   const int n = 20000;
   double sum = 0;
@@ -23,7 +23,9 @@ double quadrature(Vec3 origin, Vec3 dir, double t0, double t1, Vec3 star, float 
 TEST(ChordIrradiance, IsTheMeanOfTheInverseSquareOverTheChordNearAndFar) {
   const Vec3 origin{0, 0, -5}, dir{0, 0, 1}, star{0.02f, -0.01f, 0.013f};
   const RayFootprint footprint{0.0f, 0.001f};
-  const float soft2 = std::pow(footprint.width(5.013f), 2.0f) * float(kInv4Pi);
+  // The pixel's b^2 less the ray's: what the line's distance is softened by.
+  const Vec3 off{star.x, star.y, 0};
+  const float soft2 = pixel_mean_b2(off, footprint.width(5.013f), footprint) - dot(off, off);
   // Chords through the star, beside it, and far away (the cheap branch).
   const float chords[][2] = {{4.9f, 5.1f}, {4.99f, 5.0f}, {5.0f, 5.03f}, {3.0f, 3.05f}, {6.0f, 6.01f}, {1.0f, 9.0f}};
   for (const auto& c : chords) {
@@ -37,6 +39,50 @@ TEST(ChordIrradiance, IsTheMeanOfTheInverseSquareOverTheChordNearAndFar) {
     const double before = quadrature(origin, dir, c[0], tp, star, soft2) * (tp - c[0]);
     EXPECT_NEAR(before / (want * (c[1] - c[0])), 0.5, 0.02) << "chord " << c[0] << ".." << c[1];
   }
+}
+
+// The mean of 1 / |(x, y) + (u, v)| over the unit square by the midpoint rule,
+// n x n pieces (the integrand's cusp, where the square holds the origin, is
+// integrable: the rule converges as 1 / n).
+double square_quadrature(double x, double y, int n) {
+  double sum = 0;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const double u = x - 0.5 + (i + 0.5) / n, v = y - 0.5 + (j + 0.5) / n;
+      sum += 1.0 / std::hypot(u, v);
+    }
+  return sum / (double(n) * n);
+}
+
+TEST(PixelMean, IsTheMeanOfTheInverseDistanceOverTheSquarePixel) {
+  // Centre, corner, edge, inside, beside and far from the pixel; both signs.
+  const double offsets[][2] = {{0, 0},    {0.5, 0.5}, {-0.5, 0.5}, {0.5, 0},  {0.2, -0.35},
+                               {1.3, 0.4}, {-2.1, -1.7}, {3.9, 0.2}, {0, -4.5}};
+  for (const auto& o : offsets) {
+    const double want = square_quadrature(o[0], o[1], 2000);
+    const double got = square_pixel_mean_inverse_distance(float(o[0]), float(o[1]));
+    // The quadrature's own error near the cusp is below 1e-3 at 2000 x 2000.
+    EXPECT_NEAR(got / want, 1.0, 1e-3) << o[0] << ", " << o[1];
+  }
+  // The closed forms at the centre and the corner: 4 asinh(1) and 2 asinh(1).
+  EXPECT_NEAR(square_pixel_mean_inverse_distance(0, 0), 4 * std::asinh(1.0), 1e-5);
+  EXPECT_NEAR(square_pixel_mean_inverse_distance(0.5f, -0.5f), 2 * std::asinh(1.0), 1e-5);
+}
+
+TEST(PixelMean, ItsSquaredDistanceIsContinuousAndTendsToBSquared) {
+  RayFootprint f{0.0f, 0.001f, {1, 0, 0}, {0, 1, 0}};
+  const float w = 0.002f;
+  // Across the switch to b^2 - w^2 / 12 at 4 widths, along an axis and a diagonal.
+  for (const Vec3 dir : {Vec3{1, 0, 0}, Vec3{0.6f, 0.8f, 0}}) {
+    const float inside = pixel_mean_b2(3.9999f * w * dir, w, f), outside = pixel_mean_b2(4.0001f * w * dir, w, f);
+    EXPECT_NEAR(inside / outside, 1.0, 2e-4) << dir.x;
+  }
+  const Vec3 far{0.5f, 0.0f, 0};
+  EXPECT_NEAR(pixel_mean_b2(far, w, f) / dot(far, far), 1.0, 1e-5);
+  // On the star's line: 1 / (4 asinh 1)^2 of w^2; without sides (a fisheye), the round pixel's w^2 / (4 pi).
+  EXPECT_NEAR(pixel_mean_b2({}, w, f) / (w * w), 1.0 / std::pow(4 * std::asinh(1.0), 2), 1e-5);
+  const RayFootprint round{0.0f, 0.001f};
+  EXPECT_NEAR(pixel_mean_b2({}, w, round) / (w * w), 1.0 / (4 * kPiD), 1e-6);
 }
 
 TEST(ChordIrradiance, AStarOnTheRayOfAPointCameraStaysFinite) {

@@ -119,6 +119,7 @@ RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
     for (size_t k = 0; k < star_x.size(); ++k) in.stars.push_back(BakedStar{sb.stars[k], &bake.tau_v[k]});
   in.camera = make_camera(supersampled_camera(scene.camera, scene.samples_per_pixel));
   in.exposure = 1.0f;  // science pixels: the exposure goes in the metadata
+  in.star_pixels = scene.star_pixels;
   in.step = static_cast<float>(spec.step_texels * map.texel);
   in.skip = skip;
   in.deform.colour = spec.colour_deform.on;

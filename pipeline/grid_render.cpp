@@ -228,6 +228,7 @@ RenderOutput render_prepared(const PreparedGrid& p, const CameraSettings& settin
   if (in.diffuse) in.diffuse = &p.diffuse;
   in.camera = make_camera(supersampled_camera(settings, scene.samples_per_pixel));
   in.exposure = 1.0f;  // science pixels: the exposure goes in the metadata
+  in.star_pixels = scene.star_pixels;
   in.mode.voxel_sources = preview;
   std::unique_ptr<Progress> bar;
   if (p.options.progress && p.options.backend == Backend::Cpu)

@@ -251,6 +251,7 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
     in.emission.push_back({grid, grid ? 1.0f : float(scene.spectral->emission[c].scale)});
   }
   in.camera = make_camera(scene.camera);
+  in.star_pixels = scene.star_pixels;
   spectral::SpectralDiffuseLight diffuse_light;
   if (diffuse) {
     diffuse_light = spectral_diffuse_light(scene, model, read_tables, bake, in.camera, o, report, &sr.diffuse_view_seconds);

@@ -125,7 +125,7 @@ NEBULA_HD void scattered_source(const MarchScene& s, float tau_v, Vec3 to_eye, I
 
 // Whether a ray passes within s.near_star_radius of a star (tables/chord_phase.h).
 NEBULA_HD bool passes_near_a_star(const MarchScene& s, Vec3 origin, Vec3 dir) {
-  return passes_near_a_star(s.stars, s.n_stars, s.near_star_radius, origin, dir);
+  return passes_near_a_star(s.stars, s.n_stars, s.near_star_radius, s.footprint, origin, dir);
 }
 
 // A cell-centred field at `pos`: trilinear (clamped at the grid's edge) or
@@ -267,7 +267,9 @@ NEBULA_HD RayResult march_ray(const MarchScene& s, Vec3 origin, Vec3 dir, MarchM
       if (tau_v > 0.0f && s.n_stars > 0) {
         scattered_source<kChordPhase>(
             s, tau_v, to_eye,
-            [&](int k_star) { return chord_irradiance(origin, dir, t, t + chord, s.stars[k_star].position, s.footprint); },
+            [&](int k_star) {
+              return chord_irradiance<kChordPhase>(origin, dir, t, t + chord, s.stars[k_star].position, s.footprint);
+            },
             [&](int k_star) { return s.stars[k_star].depth_v[cell]; }, source, &out.table_clamps);
       }
       if constexpr (kDiffuse) {

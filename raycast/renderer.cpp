@@ -14,6 +14,7 @@
 #include "raycast/diffuse_light.h"
 #include "raycast/host_copy.h"
 #include "raycast/march_scene.h"
+#include "illumination/star_pixels_cpu.h"
 #include "raycast/voxel_sources.h"
 
 namespace nebula {
@@ -145,6 +146,20 @@ Image render_cpu(const RenderInputs& in, RenderStats* stats) {
       clamps += local_clamps;
       if (in.progress) in.progress->add(rows.size());
     });
+    if constexpr (exact) {
+      // The pixels at each star's image, with many rays each (illumination/star_pixels.h).
+      if (in.star_pixels)
+      march_star_pixels_cpu(in.camera, star_positions(in.stars), scene.n_bands, in.exposure, image.pixels.data(),
+                            [&](Vec3 origin, Vec3 dir, int side, float* out, size_t stride) {
+                              MarchScene sub = scene;
+                              sub.footprint = sub_pixel_footprint(scene.footprint, side);
+                              const RayResult r =
+                                  march_ray<false, diffuse(), false, zonal(), true>(sub, origin, dir, in.mode);
+                              for (int b = 0; b < scene.n_bands; ++b) out[size_t(b) * stride] = r.radiance[b];
+                              return uint64_t(r.table_clamps);
+                            },
+                            clamps);
+    }
   });
   if (stats) {
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -37,6 +37,7 @@ struct RenderInputs {
   float exposure = 1.0f;
   float min_transmittance = 1e-4f;
   MarchMode mode;  // exact traversal by default; step_voxels > 0: smooth display mode
+  bool star_pixels = true;  // the pixels at each star's image with many rays each (illumination/star_pixels.h)
   Progress* progress = nullptr;  // advanced in image rows (CPU); may be null
 };
 

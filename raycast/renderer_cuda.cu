@@ -16,6 +16,7 @@
 #include "raycast/host_copy.h"
 #include "raycast/march_scene.h"
 #include "raycast/renderer.h"
+#include "illumination/star_pixels.h"
 #include "raycast/voxel_sources.h"
 
 namespace nebula {
@@ -93,6 +94,33 @@ __global__ void __launch_bounds__(256, kSmooth ? 2 : NEBULA_RENDER_MIN_BLOCKS)
   if (r.table_clamps) atomicAdd(clamps, static_cast<unsigned long long>(r.table_clamps));
 }
 
+// One thread per ray of the pixels at each star's image (illumination/star_pixels.h),
+// each ray standing for its sub-pixel, into sub (kMaxBands per ray); the
+// store kernel then averages each pixel's rays in their order. Launched on
+// the near rays' side stream, beside the main launch.
+template <bool kDiffuse, bool kZonal>
+__global__ void __launch_bounds__(256) star_pixel_kernel(MarchScene scene, Camera camera, MarchMode mode,
+                                                         const StarPixel* list, int n, int rays, float* sub,
+                                                         unsigned long long* clamps) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= rays) return;
+  const RayFootprint pixel = scene.footprint;
+  const int n_clamps = march_star_pixel_ray(camera, list, n, rays, i, kMaxBands, sub,
+                                            [&](Vec3 origin, Vec3 dir, int side, float* out, size_t stride) {
+    scene.footprint = sub_pixel_footprint(pixel, side);
+    const RayResult r = march_ray<false, kDiffuse, false, kZonal, true>(scene, origin, dir, mode);
+    for (int b = 0; b < kMaxBands; ++b) out[size_t(b) * stride] = r.radiance[b];
+    return r.table_clamps;
+  });
+  if (n_clamps) atomicAdd(clamps, static_cast<unsigned long long>(n_clamps));
+}
+
+__global__ void star_pixel_store_kernel(const StarPixel* list, int n, const float* sub, int rays, int n_bands,
+                                        float exposure, float* pixels, int width, int height) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i < n) store_star_pixel(sub, size_t(rays), list[i], n_bands, exposure, pixels, width, height);
+}
+
 // A device array kept per thread and reused while the size asked for fits:
 // frames of an animation or a viewer allocate nothing. A fresh allocation and
 // release of a frame's buffers (25 MB for 1080p in 3 bands, 64 MB per band of
@@ -128,6 +156,8 @@ struct PinnedStaging {
 struct FrameBuffers {
   std::unique_ptr<DeviceArray<float>> pixels, light[kMaxBands], peak[kMaxBands];
   std::unique_ptr<DeviceArray<unsigned long long>> clamps;
+  std::unique_ptr<DeviceArray<StarPixel>> star_pixels;
+  std::unique_ptr<DeviceArray<float>> star_rays;
   PinnedStaging staging;
   SideStream near;
 };
@@ -181,13 +211,31 @@ double render_cuda_to_device(const RenderInputs& in, float* pixels, unsigned lon
   dispatch_march(scene, in.mode, [&](auto smooth, auto diffuse, auto voxel_sources, auto zonal) {
     if constexpr (!smooth() && !voxel_sources()) {
       if (scene.n_stars > 0) {
+        int rays = 0;
+        const std::vector<StarPixel> list =
+            in.star_pixels ? star_pixels(in.camera, star_positions(in.stars), &rays) : std::vector<StarPixel>{};
+        StarPixel* device_list = nullptr;
+        float* sub = nullptr;
+        if (!list.empty()) {
+          device_list = reused(frame_buffers.star_pixels, list.size());
+          NEBULA_CUDA_CHECK(cudaMemcpy(device_list, list.data(), list.size() * sizeof(StarPixel), cudaMemcpyHostToDevice));
+          sub = reused(frame_buffers.star_rays, size_t(rays) * kMaxBands);
+        }
         SideStream& side = frame_buffers.near;
         side.start();
         render_kernel<false, diffuse(), false, zonal(), RaySet::Near>
             <<<grid, block, 0, side.stream>>>(scene, in.camera, in.mode, in.exposure, pixels, clamps);
+        if (!list.empty())
+          star_pixel_kernel<diffuse(), zonal()><<<unsigned((rays + 255) / 256), 256, 0, side.stream>>>(
+              scene, in.camera, in.mode, device_list, int(list.size()), rays, sub, clamps);
         render_kernel<false, diffuse(), false, zonal(), RaySet::Far>
             <<<grid, block>>>(scene, in.camera, in.mode, in.exposure, pixels, clamps);
         side.join();
+        // After both launches: the star pixels replace their single rays.
+        if (!list.empty())
+          star_pixel_store_kernel<<<unsigned((list.size() + 127) / 128), 128>>>(
+              device_list, int(list.size()), sub, rays, scene.n_bands, in.exposure, pixels, in.camera.width,
+              in.camera.height);
         return;
       }
     }

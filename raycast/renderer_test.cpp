@@ -141,9 +141,58 @@ TEST(Renderer, AChordBesideTheStarAveragesThePhaseOverItsAngles) {
   }
 }
 
+// A pixel holds its area's mean. Near a star the light changes within a
+// pixel: 1/b from the star, taken as the square pixel's mean of 1/b
+// (pixel_mean_b2), and at g = 0.9 the phase's forward peak, seen from the star
+// under angles b/s, which the pixels at the star's image get from many rays
+// each (illumination/star_pixels.h). A thin sphere around a star on the common
+// corner of the four central pixels (where one ray at the pixel's centre sees
+// 0.80 of the mean of 1/b, and a round pixel centred on the star 0.75 of it),
+// and one near a pixel's centre: the default render against a render of
+// 10 x 10 pixels per pixel, averaged (its rays apart from the star pixels'
+// strata), in the 6 x 6 pixels around the star. What remains is the
+// rays' ends in the sphere (a part w / R of the line integral for the pixels
+// beside the star, here 1/6 / 0.8 / pi of it, under 7%, and far less for the
+// central pixels, whose light is mostly near the star), and the phase's change
+// across the pixels outside the star pixels (3 pixels and more from the star).
+TEST(Renderer, PixelsNearAStarHoldTheirAreaMean) {
+  const int n = 32, pixels = 12, k = 10;  // 10 x 10 finer pixels: rays apart from the star pixels' strata
+  const float half = 1.0f, radius = 0.8f, kappa = 1e-3f;
+  for (const double g : {0.0, 0.6, 0.9})
+    for (const Vec3 star : {Vec3{0, 0, 0}, Vec3{0.07f, -0.05f, 0.02f}}) {
+      OneStarScene one, many;
+      for (OneStarScene* s : {&one, &many}) {
+        s->grid = cube(n, half);
+        fill_sphere(s->grid, radius, kappa * s->grid.shape.voxel);
+        s->table = thin_table(g);
+      }
+      one.finish(star, 1000.0f, 0.6f, telescope(pixels, 2.0f));
+      many.finish(star, 1000.0f, 0.6f, telescope(pixels * k, 2.0f));
+      const Image a = render_cpu(one.inputs, nullptr), b = render_cpu(many.inputs, nullptr);
+      double worst_centre = 0, worst_ring = 0;
+      for (int y = pixels / 2 - 3; y < pixels / 2 + 3; ++y)
+        for (int x = pixels / 2 - 3; x < pixels / 2 + 3; ++x) {
+          double mean = 0;
+          for (int j = 0; j < k; ++j)
+            for (int i = 0; i < k; ++i) mean += b.at(0, x * k + i, y * k + j);
+          mean /= k * k;
+          const double e = std::fabs(a.at(0, x, y) / mean - 1);
+          const bool centre = std::abs(2 * x + 1 - pixels) <= 1 && std::abs(2 * y + 1 - pixels) <= 1;
+          (centre ? worst_centre : worst_ring) = std::max(centre ? worst_centre : worst_ring, e);
+        }
+      EXPECT_LT(worst_centre, 0.03) << "g " << g << " star x " << star.x;
+      EXPECT_LT(worst_ring, 0.07) << "g " << g << " star x " << star.x;
+      std::printf("g %.1f, star at (%.2f, %.2f): against 100 pixels per pixel, central 4 pixels %.2f%%, around %.2f%%\n",
+                  g, star.x, star.y, 100 * worst_centre, 100 * worst_ring);
+    }
+}
+
 // The rays passes_near_a_star leaves out have no chord (of at most a voxel's
-// diagonal) that chord_phase_mean would average: the CPU loop and the CUDA
-// launch split the rays there without changing the image.
+// diagonal) that chord_phase_mean would average, and pass no star within 4 of
+// their pixels' widths: the CPU loop and the CUDA launch split the rays there
+// without changing the image (the far rays' chord_irradiance<false> is the
+// near one's, bit for bit). Pixels wide against the phase's radius (the
+// second footprint) make the widths decide.
 TEST(Renderer, RaysFarFromEveryStarKeepTheHalfLightPoint) {
   const float l = 0.05f;
   const int n_mu = 72;
@@ -156,26 +205,40 @@ TEST(Renderer, RaysFarFromEveryStarKeepTheHalfLightPoint) {
   scene.stars = &star;
   scene.n_stars = 1;
   scene.near_star_radius = chord_phase_radius(std::sqrt(3.0f) * l, n_mu);
-  UniformStream rng(7, 0, 0, 0);
-  int far = 0, near_averaged = 0;
-  for (int i = 0; i < 200000; ++i) {
-    const Vec3 origin{4 * rng.next() - 2, 4 * rng.next() - 2, 4 * rng.next() - 2};
-    Vec3 dir{rng.next() - 0.5f, rng.next() - 0.5f, rng.next() - 0.5f};
-    dir = normalize(dir);
-    // A chord on the ray near its closest approach to the star (or its start).
-    const float tc = fmaxf(dot(star.position - origin, dir), 0.0f);
-    const float t0 = fmaxf(tc + (rng.next() - 0.5f) * 4 * l, 0.0f), t1 = t0 + std::sqrt(3.0f) * l * rng.next();
-    const ChordIrradiance at = chord_irradiance(origin, dir, t0, t1, star.position, RayFootprint{});
-    const bool mean = chord_takes_phase_mean(table, at.a0, at.a1);
-    if (!passes_near_a_star(scene, origin, dir)) {
-      ++far;
-      ASSERT_FALSE(mean) << "ray " << i;
-    } else if (mean) {
-      ++near_averaged;
+  const RayFootprint footprints[] = {{0.0f, 0.002f, {1, 0, 0}, {0, 1, 0}}, {0.3f, 0.1f, {0.6f, 0.8f, 0}, {-0.8f, 0.6f, 0}}};
+  for (const RayFootprint& footprint : footprints) {
+    scene.footprint = footprint;
+    UniformStream rng(7, 0, 0, 0);
+    int far = 0, near_averaged = 0, far_within_widths = 0;
+    for (int i = 0; i < 200000; ++i) {
+      const Vec3 origin{4 * rng.next() - 2, 4 * rng.next() - 2, 4 * rng.next() - 2};
+      Vec3 dir{rng.next() - 0.5f, rng.next() - 0.5f, rng.next() - 0.5f};
+      dir = normalize(dir);
+      // A chord on the ray near its closest approach to the star (or its start).
+      const float tc = fmaxf(dot(star.position - origin, dir), 0.0f);
+      const float t0 = fmaxf(tc + (rng.next() - 0.5f) * 4 * l, 0.0f), t1 = t0 + std::sqrt(3.0f) * l * rng.next();
+      const ChordIrradiance at = chord_irradiance(origin, dir, t0, t1, star.position, footprint);
+      const bool mean = chord_takes_phase_mean(table, at.a0, at.a1);
+      if (!passes_near_a_star(scene, origin, dir)) {
+        ++far;
+        ASSERT_FALSE(mean) << "ray " << i;
+        const ChordIrradiance cheap = chord_irradiance<false>(origin, dir, t0, t1, star.position, footprint);
+        ASSERT_EQ(cheap.inv_r2, at.inv_r2) << "ray " << i;
+        ASSERT_EQ(cheap.a0, at.a0) << "ray " << i;
+        ASSERT_EQ(cheap.a1, at.a1) << "ray " << i;
+      } else if (mean) {
+        ++near_averaged;
+      } else {
+        const Vec3 to_star = star.position - origin;
+        const Vec3 off = to_star - tc * dir;
+        far_within_widths += dot(off, off) >= scene.near_star_radius * scene.near_star_radius;
+      }
     }
+    EXPECT_GT(far, 1000);
+    EXPECT_GT(near_averaged, 1000);
+    // The wide pixels make some rays near by their widths alone.
+    if (footprint.width_at_eye > 0.0f) EXPECT_GT(far_within_widths, 1000);
   }
-  EXPECT_GT(far, 1000);
-  EXPECT_GT(near_averaged, 1000);
 }
 
 TEST(Renderer, PureExtinctionThroughASlab) {
@@ -329,6 +392,9 @@ TEST(Renderer, SmoothModeConvergesToTheExactTraversal) {
   cs.up = {0, 0, 1};
   cs.width = cs.height = 48;
   s.finish({0.1f, 0.05f, -0.2f}, 10.0f, 0.6f, make_camera(cs));
+  // The exact traversal's star pixels (many rays each) have no smooth-mode
+  // counterpart: compared ray for ray, one ray per pixel.
+  s.inputs.star_pixels = false;
   const Image exact = render_cpu(s.inputs, nullptr);
   double norm = 0;
   for (float v : exact.pixels) norm += v;

@@ -213,6 +213,10 @@ struct Scene {
   // pixel's area, so a pixel is its area's mean, not its centre's value (the
   // 1/d cusp next to a star). A square in 1..kMaxSamplesPerPixel.
   int samples_per_pixel = 1;
+  // The pixels at each star's image marched with many rays each ([render]
+  // star_pixels; illumination/star_pixels.h): their light changes within a
+  // pixel (1/d, the phase's forward peak). Off: one ray each.
+  bool star_pixels = true;
 };
 
 constexpr int kMaxSamplesPerPixel = 256;

@@ -72,7 +72,7 @@ const std::initializer_list<std::string_view> kSpectralEmissionKeys = {"line_nm"
                                                                        "dataset", "scale"};
 const std::initializer_list<std::string_view> kRenderKeys = {
     "levels", "multiple_scattering", "diffuse_order", "diffuse_zonal", "diffuse_cells", "diffuse_photons", "diffuse_seed",
-    "samples_per_pixel"};
+    "samples_per_pixel", "star_pixels"};
 const std::initializer_list<std::string_view> kAxialKeys = {
     "synthetic", "file", "image", "dataset", "emission_prefix", "tau_channel", "emission_channels", "nx", "nr",
     "length_pc", "tau_scale", "emission_scale", "origin", "axis", "skip", "step_texels", "colour_deform",
@@ -907,6 +907,7 @@ void Parser::parse_render(const toml::table& root, Scene& scene) const {
     scene.samples_per_pixel = small_integer(*v, "render.samples_per_pixel");
     if (auto issue = scene_detail::samples_per_pixel_issue(scene.samples_per_pixel)) fail(issue->key, issue->reason);
   }
+  if (const toml::node* v = t.get("star_pixels")) scene.star_pixels = boolean(*v, "render.star_pixels");
 }
 
 void Parser::load_grids(const DensityPlan& density, const std::optional<EmissionPlan>& emission,

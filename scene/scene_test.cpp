@@ -404,6 +404,16 @@ TEST_F(SceneFile, DiffuseZonalIsAutoOrAWholeNumberAboveTheOrder) {
   refused("zonal_minus_one", kBase + std::string("\n[render]\ndiffuse_zonal = -1\n"), {"render.diffuse_zonal", "\"auto\""});
 }
 
+// render.star_pixels: true by default (the pixels at a star's image marched
+// with many rays each), false turns it off; anything but a boolean refused.
+TEST_F(SceneFile, StarPixelsAreOnUnlessTurnedOff) {
+  EXPECT_TRUE(load_scene(write_text("star_pixels_base.toml", kBase)).star_pixels);
+  EXPECT_FALSE(load_scene(write_text("star_pixels_off.toml", kBase + std::string("\n[render]\nstar_pixels = false\n")))
+                   .star_pixels);
+  refused("star_pixels_word", kBase + std::string("\n[render]\nstar_pixels = \"yes\"\n"),
+          {"render.star_pixels", "true or false"});
+}
+
 // render.diffuse_order: "auto" (the default: 4, or 3 where zonal degrees carry
 // the stars' light), or a whole number 0 to 4; anything else refused by name.
 TEST_F(SceneFile, DiffuseOrderIsAutoOrAWholeNumberUpToFour) {

@@ -224,7 +224,7 @@ NEBULA_HD PairWeights pair_weights(const SpectralSceneView& s, float w, float ta
   const float thin = p.tau_sct * hg_phase(mu, s.g);
   p.scale = thin > 0.0f ? w / thin : 0.0f;
   p.u = s.table.angle_coordinate(mu);
-  if (at && s.table.n_mu > 0 && chord_takes_phase_mean(s.table, at->a0, at->a1)) {
+  if (at && s.table.n_mu > 0 && s.table.C && chord_takes_phase_mean(s.table, at->a0, at->a1)) {
     p.mean = true;
     p.a0 = at->a0;
     p.a1 = at->a1;
@@ -634,16 +634,20 @@ NEBULA_HD VoxelStarPair voxel_star_pair(const SpectralSceneView& s, const Camera
   const float A = 1.0f + g2 - 2.0f * s.g * mu, inv_A = 1.0f / A;
   const float curvature = 2.0f + fabsf(3.0f * s.g * (mu * A - 2.0f * s.g * (1.0f - mu * mu))) * inv_A * inv_A;
   const float lit = tau > 0.0f ? 1.0f : 0.0f;
-  const float close = r2 < near2 * curvature ? lit : 0.0f;
-  const float x = depth * c.inv_step;
-  // Products of 0/1 flags, not &&: no branch (beyond the table: below the transmittance cut).
-  const float take = (lit - close) * (x < c.last ? 1.0f : 0.0f);
-  // r^2 softened by the pixel's footprint at the star, as chord_irradiance does (a ray
-  // stands for its pixel): 1 / (r^2 + w^2 / (4 pi)).
+  // The pixel's width at the star: within 6 of them a ray's chords take the
+  // square pixel's mean of 1/b (illumination/chord_irradiance.h), which a
+  // voxel's light cannot (it has no ray), to within 1%; those pairs are exact too.
   const float t_star =
       (camera.position.x - star.x) * e.x + (camera.position.y - star.y) * e.y + (camera.position.z - star.z) * e.z;
   const float width = s.footprint.width_at_eye + 0.5f * (t_star + fabsf(t_star)) * s.footprint.spread;
-  const float inv_r2 = 1.0f / (r2 + width * width * kInv4Pi);
+  const float w2 = width * width;
+  const float close = r2 < near2 * curvature || r2 < 36.0f * w2 ? lit : 0.0f;
+  const float x = depth * c.inv_step;
+  // Products of 0/1 flags, not &&: no branch (beyond the table: below the transmittance cut).
+  const float take = (lit - close) * (x < c.last ? 1.0f : 0.0f);
+  // r^2 as the rays' chords take it beyond 6 pixel widths (chord_irradiance's
+  // far formula, pixel_mean_b2<false>): r^2 - w^2 / 12.
+  const float inv_r2 = 1.0f / fmaxf(r2 - w2 * (1.0f / 12.0f), 1e-30f);
   const float wi = power * tau * inv_r2 * inv_A * sqrtf(inv_A) * take;
   // grad ln w = -2 d / r2 + (d ln p / d mu) grad mu, grad mu = (e - mu h) / r - (h - mu e) / rho.
   const float a = -2.0f * inv_r2, b = 3.0f * s.g * inv_A;
@@ -822,7 +826,7 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
 // Whether a ray passes within s.near_star_radius of a star: only those take
 // the phase's mean over their chords' angles (kChordPhase below).
 NEBULA_HD bool passes_near_a_star(const SpectralSceneView& s, Vec3 origin, Vec3 dir) {
-  return nebula::passes_near_a_star(s.stars, s.n_stars, s.near_star_radius, origin, dir);
+  return nebula::passes_near_a_star(s.stars, s.n_stars, s.near_star_radius, s.footprint, origin, dir);
 }
 
 // One ray: the accumulators (n_acc of them) before the resolve.
@@ -868,7 +872,7 @@ NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir,
           while (!((near >> k) & 1u)) ++k;
           float fd = 0.0f;
           if (!star_integrals(s, k, 0, cell, fd)) continue;
-          const ChordIrradiance at = chord_irradiance(origin, dir, t, t + chord, s.stars[k].position, s.footprint);
+          const ChordIrradiance at = chord_irradiance<kChordPhase>(origin, dir, t, t + chord, s.stars[k].position, s.footprint);
           const Vec3 d = at.point - s.stars[k].position;
           const float r = length(d);
           const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
@@ -891,7 +895,7 @@ NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir,
     } else if (tau_v > 0.0f) {
       // Projection's accumulators have a row per star: unrolled over the stars, so that row is a constant.
       for_each_index<kMethod == SpectralMethod::Projection ? Acc::kRows : 0>(s.n_stars, [&](int k) {
-        const ChordIrradiance at = chord_irradiance(origin, dir, t, t + chord, s.stars[k].position, s.footprint);
+        const ChordIrradiance at = chord_irradiance<kChordPhase>(origin, dir, t, t + chord, s.stars[k].position, s.footprint);
         const Vec3 d = at.point - s.stars[k].position;
         const float r = length(d);
         const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "illumination/star_pixels_cpu.h"
 
 namespace nebula::spectral {
 namespace {
@@ -215,6 +216,23 @@ Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds) {
           store_emission(view, em, &image.at(0, x, y), image.plane_size());
         }
     });
+    // The pixels at each star's image, with many rays each (illumination/star_pixels.h).
+    std::vector<Vec3> positions;
+    if (in.star_pixels)
+      for (const SpectralLight& l : in.lights) positions.push_back(l.position);
+    std::atomic<uint64_t> no_clamps{0};  // the spectral marcher counts none
+    march_star_pixels_cpu(in.camera, positions, m.planes(), 1.0f, image.pixels.data(),
+                          [&](Vec3 origin, Vec3 dir, int side, float* out, size_t stride) {
+                            SpectralSceneView sub = view;
+                            sub.footprint = sub_pixel_footprint(view.footprint, side);
+                            DynamicAccumulators acc;
+                            float em[kMaxEmissionPlanes];
+                            march_spectral<method(), true>(sub, origin, dir, acc, em);
+                            store_accumulators(sub, acc, out, stride);
+                            store_emission(sub, em, out, stride);
+                            return uint64_t(0);
+                          },
+                          no_clamps);
   });
   if (seconds) *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return image;

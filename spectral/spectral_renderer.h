@@ -70,6 +70,7 @@ struct SpectralRenderInputs {
   // With a table and table nodes (the model's); null: none.
   const SpectralDiffuseLight* diffuse = nullptr;
   Camera camera;
+  bool star_pixels = true;  // the pixels at each star's image with many rays each (illumination/star_pixels.h)
   VoxelLightWorkspace* workspace = nullptr;  // VoxelLight on the CPU: reused buffers (optional)
 };
 

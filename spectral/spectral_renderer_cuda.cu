@@ -11,6 +11,7 @@
 #include "core/cuda_side_stream.h"
 #include "core/cuda_timer.h"
 #include "core/device_array.h"
+#include "illumination/star_pixels.h"
 #include "spectral/spectral_renderer.h"
 
 namespace nebula::spectral {
@@ -36,6 +37,32 @@ __global__ void spectral_kernel(SpectralSceneView scene, Camera camera, float* p
   const size_t stride = size_t(camera.width) * camera.height;
   store_accumulators(scene, acc, pixels + size_t(y) * camera.width + x, stride);
   store_emission(scene, em, pixels + size_t(y) * camera.width + x, stride);
+}
+
+// One thread per ray of the pixels at each star's image (illumination/star_pixels.h),
+// each standing for its sub-pixel, into sub (plane k of ray i at sub[k * rays + i]).
+template <SpectralMethod kMethod, class Acc>
+__global__ void spectral_star_pixel_kernel(SpectralSceneView scene, Camera camera, const StarPixel* list, int n,
+                                           int rays, int n_planes, float* sub) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= rays) return;
+  const RayFootprint pixel = scene.footprint;
+  march_star_pixel_ray(camera, list, n, rays, i, n_planes, sub,
+                       [&](Vec3 origin, Vec3 dir, int side, float* out, size_t stride) {
+    scene.footprint = sub_pixel_footprint(pixel, side);
+    Acc acc;
+    float em[kMaxEmissionPlanes];
+    march_spectral<kMethod, true>(scene, origin, dir, acc, em);
+    store_accumulators(scene, acc, out, stride);
+    store_emission(scene, em, out, stride);
+    return 0;
+  });
+}
+
+__global__ void spectral_star_pixel_store_kernel(const StarPixel* list, int n, const float* sub, int rays,
+                                                 int n_planes, float* pixels, int width, int height) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i < n) store_star_pixel(sub, size_t(rays), list[i], n_planes, 1.0f, pixels, width, height);
 }
 
 // VoxelLight's per-view pre-pass: one voxel per thread (spectral_march.h);
@@ -211,6 +238,13 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
   Image image(in.camera.width, in.camera.height, names);
   DeviceArray<float> pixels(image.pixels.size());
   const dim3 block(16, 16), grid((in.camera.width + 15) / 16, (in.camera.height + 15) / 16);
+  std::vector<Vec3> positions;
+  if (in.star_pixels)
+    for (const SpectralLight& l : in.lights) positions.push_back(l.position);
+  int rays = 0;
+  const std::vector<StarPixel> list = star_pixels(in.camera, positions, &rays);
+  const DeviceArray<StarPixel> device_list(list);
+  DeviceArray<float> sub(size_t(rays) * size_t(m.planes()));
   CudaEventTimer timer;
   const unsigned pre_blocks = unsigned((cells + 255) / 256);
   if (in.diffuse) {
@@ -227,12 +261,19 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
   }
   dispatch_method(m.settings.method, [&](auto method) {
     with_accumulators<method()>(view, [&](auto acc) {
-      if (view.near_star_radius > 0.0f && view.n_stars > 0) {
+      if (view.n_stars > 0) {
         near_rays.start();
         spectral_kernel<method(), decltype(acc), true>
             <<<grid, block, 0, near_rays.stream>>>(view, in.camera, pixels.get());
+        if (!list.empty())
+          spectral_star_pixel_kernel<method(), decltype(acc)><<<unsigned((rays + 127) / 128), 128, 0, near_rays.stream>>>(
+              view, in.camera, device_list.get(), int(list.size()), rays, m.planes(), sub.get());
         spectral_kernel<method(), decltype(acc), false><<<grid, block>>>(view, in.camera, pixels.get());
         near_rays.join();
+        if (!list.empty())  // after both launches: the star pixels replace their single rays
+          spectral_star_pixel_store_kernel<<<unsigned((list.size() + 127) / 128), 128>>>(
+              device_list.get(), int(list.size()), sub.get(), rays, m.planes(), pixels.get(), in.camera.width,
+              in.camera.height);
       } else {
         spectral_kernel<method(), decltype(acc), false><<<grid, block>>>(view, in.camera, pixels.get());
       }

@@ -3,6 +3,7 @@
 // star under: the marchers' near-star phase (raycast/ray_march.h and
 // spectral/spectral_march.h; docs/marcher.md, "The phase over the chord's
 // angles").
+#include "core/camera.h"
 #include "core/hd.h"
 #include "core/math.h"
 #include "tables/table_lookup.h"
@@ -48,17 +49,26 @@ inline float chord_phase_radius(float chord, int n_mu) {
 }
 
 // Whether a ray from `origin` along unit `dir` passes within `radius`
-// (chord_phase_radius) of one of the n stars (each with a .position): only
-// such rays have chords whose angles chord_phase_mean averages, so the
-// marchers march the others without it (their kernels keep their registers)
-// and give the same image.
+// (chord_phase_radius) of one of the n stars (each with a .position), or
+// within 4 of its pixel's widths there (the footprint): only such rays have
+// chords whose angles chord_phase_mean averages or whose pixel's mean of 1/b
+// needs its closed form (illumination/chord_irradiance.h), so the marchers
+// march the others without them (their kernels keep their registers) and
+// give the same image.
 template <class Star>
-NEBULA_HD bool passes_near_a_star(const Star* stars, int n, float radius, Vec3 origin, Vec3 dir) {
+NEBULA_HD bool passes_near_a_star(const Star* stars, int n, float radius, const RayFootprint& footprint, Vec3 origin,
+                                  Vec3 dir) {
   const float r2 = radius * radius;
   for (int k = 0; k < n; ++k) {
     const Vec3 to_star = stars[k].position - origin;
-    const Vec3 off = to_star - fmaxf(dot(to_star, dir), 0.0f) * dir;
-    if (dot(off, off) < r2) return true;
+    const float tc = dot(to_star, dir);
+    // The line's distance, as chord_irradiance takes it (a star behind the
+    // origin included); the chords' distance for the phase.
+    const Vec3 off = to_star - tc * dir;
+    const float w4 = 4.0f * footprint.width(tc);
+    if (dot(off, off) < w4 * w4) return true;
+    const Vec3 chords_off = tc > 0.0f ? off : to_star;
+    if (dot(chords_off, chords_off) < r2) return true;
   }
   return false;
 }

@@ -38,8 +38,9 @@ def study_arguments(description, work, out, scenes):
     ap.add_argument("--spp", type=int, default=512, help="truth samples per pixel")
     ap.add_argument("--truth-strata", type=int, default=1,
                     help="the truth's pixel-area strata per side (render.samples_per_pixel = this squared, for the "
-                         "truth only; 1: each pixel's centre ray, as the fast renderer traces); spp must be a multiple "
-                         "of its square")
+                         "truth only; 1: each pixel's centre ray). The fast renderer's one ray per pixel stands for "
+                         "the pixel's area near a star, so the pixels around one compare only with strata; spp must "
+                         "be a multiple of its square")
     ap.add_argument("--fig12-pixels", type=int, default=128, help="image size of the Fig. 12 scene")
     ap.add_argument("--albedos", default="0.3,0.6,0.9")
     ap.add_argument("--gs", default="0,0.6,0.9")
