@@ -47,6 +47,8 @@ def scene_path(work, name):
 def main():
     ap = study_arguments(__doc__.split("\n")[0], "/tmp/nebula-ms-study", "docs/multiple_scattering.md", SCENES)
     ap.add_argument("--methods", default=",".join(METHODS))
+    ap.add_argument("--note", default="", help="a paragraph for the page, under its header (what the merged runs "
+                    "differ in, for example)")
     ap.add_argument("--merge", default="", help="comma-separated JSON rows of earlier runs (e.g. one per group of "
                     "scenes, each within a device call's time): write the page from them, render nothing")
     args = ap.parse_args()
@@ -127,6 +129,8 @@ def write_page(rows, args, albedos, gs, methods, elapsed):
            f"{args.fig12_pixels}x{args.fig12_pixels} pixels, the others at their own 64x64. Each cell: the V-band "
            "bias Σ(fast − truth)/Σtruth over pixels with signal, then (in brackets) the L2 error beyond the truth's "
            "noise. The method is [docs/diffuse.md](diffuse.md).\n"]
+    if args.note:
+        out.append(args.note + "\n")
     scenes = list(dict.fromkeys(x["scene"] for x in rows))
     for method in methods:
         out.append(f"## {method}\n")
