@@ -35,11 +35,16 @@ camera.exposure) and the same tone mapping as `nebula render -o X.png`
 so brightness and colour compare directly. Writes each image as HDF5 (the
 data, which compare reads) and PNG into --renders, and the montage into --out.
 --no-truth leaves the truth out (quick looks; the montage is the fast row).
+--render-only runs the renders and truths and stops (no numpy, h5py or
+matplotlib needed: for a GPU machine without them); --reuse then makes the
+montage elsewhere from those files, rendering only what is missing or was
+rendered with other arguments (each HDF5 has its arguments beside it, in
+NAME.h5.args).
 
 Usage: /usr/bin/python3 validation/gallery.py [--study fig12|pyramid|axial|axial_deform|axial_ms]
            [--nebula build/bin/nebula] [--scene SCENE (default: the study's)]
            [--out docs/images] [--renders out/gallery] [--size 384]
-           [--truth-spp 256 | --no-truth] [--backend auto]
+           [--truth-spp 256 | --no-truth] [--backend auto] [--render-only | --reuse]
 Needs numpy, h5py and matplotlib (Debian: python3-numpy, python3-h5py,
 python3-matplotlib).
 """
@@ -121,6 +126,22 @@ def run(command, what):
     return result.stdout
 
 
+def render_file(nebula, arguments, h5, what, reuse):
+    """Runs `nebula arguments` (which write h5) and records the arguments in h5.args; with reuse, an h5 whose
+    recorded arguments are the same is kept as it is (rendered before, perhaps on another machine)."""
+    record = h5 + ".args"
+    wanted = json.dumps([os.path.basename(a) if a == h5 else a for a in arguments])  # movable with its folder
+    if reuse and os.path.isfile(h5) and os.path.isfile(record):
+        with open(record) as f:
+            if f.read() == wanted:
+                print(f"  reusing {h5}", flush=True)
+                return
+    run([nebula] + arguments, what)
+    with open(record + ".tmp", "w") as f:
+        f.write(wanted)
+    os.replace(record + ".tmp", record)
+
+
 def write_png(h5_path, png_path):
     """The PNG of an HDF5 image exactly as `nebula render -o X.png` tone-maps it (docs/image_files.md):
     value x exposure clamped to [0, 1], sRGB curve (IEC 61966-2-1), rounded to 8 bits; red, green, blue from
@@ -161,7 +182,8 @@ def caption(bands):
     def signed(v):
         return f"{100 * v:+.1f}%".replace("-", "\u2212")
 
-    text = f"{band['band']} bias {signed(band['bias'])} \u00b1 {100 * band['bias_stderr']:.1f}%"
+    error = 100 * band["bias_stderr"]
+    text = f"{band['band']} bias {signed(band['bias'])} \u00b1 {error:.{2 if error < 0.1 else 1}f}%"
     if band.get("has_variance"):
         text += f"\n(L2 beyond noise {band['rel_l2_excess']:.2f})"
     return text
@@ -190,7 +212,15 @@ def main():
                         help="samples per pixel of the truth (nebula truth --equiangular --spp)")
     parser.add_argument("--no-truth", action="store_true", help="the fast images only (quick looks)")
     parser.add_argument("--backend", default="auto")
+    parser.add_argument("--render-only", action="store_true",
+                        help="render the HDF5 files into --renders and stop (no numpy, h5py or matplotlib needed)")
+    parser.add_argument("--reuse", action="store_true",
+                        help="keep the HDF5 files in --renders rendered with the same arguments (from --render-only)")
     args = parser.parse_args()
+    if args.render_only and args.reuse:
+        fail("--render-only and --reuse: give one (render here, or compose from earlier renders)")
+    if args.render_only and args.study == "axial_deform":
+        fail("--render-only: the axial_deform study reads its map with h5py while rendering; run it whole")
     montage_name, suptitle, scene, truth_mode, variants = STUDIES[args.study]
     args.scene = args.scene or scene
     if args.no_truth:
@@ -207,20 +237,23 @@ def main():
     if truth_mode and args.truth_spp < 2:
         fail("--truth-spp: at least 2 (the truth's variance needs two samples)")
 
-    import matplotlib
+    if not args.render_only:
+        import matplotlib
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
 
     size = ["--width", str(args.size), "--height", str(args.size)]
     truth_label = f"truth (path tracer, {args.truth_spp} spp)"
 
     def render_truth(name, extra):
         h5 = os.path.join(args.renders, f"{args.study}_{name}.h5")
-        run([args.nebula, "truth", args.scene, "-o", h5, "--force", "-q", "--equiangular", "--spp",
-             str(args.truth_spp), "--backend", args.backend] + size + extra, f"the truth of {name}")
+        render_file(args.nebula, ["truth", args.scene, "-o", h5, "--force", "-q", "--equiangular", "--spp",
+                                  str(args.truth_spp), "--backend", args.backend] + size + extra,
+                    h5, f"the truth of {name}", args.reuse)
         png = os.path.splitext(h5)[0] + ".png"
-        write_png(h5, png)
+        if not args.render_only:
+            write_png(h5, png)
         return h5, png
 
     shared_truth = render_truth("truth", []) if truth_mode == "shared" else None
@@ -249,17 +282,22 @@ def main():
     panels = []
     for key, title, extra in variants:
         h5 = os.path.join(args.renders, f"{args.study}_{key}.h5")
-        run([args.nebula, "render", args.scene, "-o", h5, "--force", "-q", "--backend", args.backend] + size + extra,
-            f"rendering {key}")
+        render_file(args.nebula, ["render", args.scene, "-o", h5, "--force", "-q", "--backend", args.backend] +
+                    size + extra, h5, f"rendering {key}", args.reuse)
         png = os.path.splitext(h5)[0] + ".png"
-        write_png(h5, png)
         truth = render_truth(f"{key}_truth", extra) if truth_mode == "each" else shared_truth
+        if args.render_only:
+            continue
+        write_png(h5, png)
         text = None
         if truth:
             text = caption(json.loads(run([args.nebula, "compare", h5, truth[0], "--json"],
                                           f"comparing {key} with the truth"))["bands"])
             print(f"  {key}: {text.replace(chr(10), ' ')}", flush=True)
         panels.append((title, png, truth[1] if truth_mode == "each" else None, text))
+    if args.render_only:
+        print(f"rendered into {args.renders}; compose with --reuse")
+        return
     if map_png:
         panels.insert(0, ("the map: sqrt(tau_v / max)\nx along the axis, r up", map_png, None, None))
 
