@@ -76,6 +76,7 @@ class Runner:
         self.backend = args.backend
         self.transmittance = args.transmittance
         self.equiangular = args.equiangular
+        self.truth_strata = args.truth_strata
         os.makedirs(self.work, exist_ok=True)
         self.env = dict(os.environ, NEBULA_CACHE_DIR=os.path.join(self.work, "cache"))
         help_text = self.run(["render", "--help"])
@@ -88,9 +89,13 @@ class Runner:
         return r.stdout
 
     def truth(self, scene, spp, seed, out, extra=()):
+        # The pixel's mean (what the fast renderer's pixels stand for near a star), from k x k jittered strata:
+        # the largest k up to --truth-strata whose square divides spp (any k estimates the same mean).
+        k = max(j for j in range(1, self.truth_strata + 1) if spp % (j * j) == 0)
+        strata = ["--set", f"render.samples_per_pixel={k * k}"] if k > 1 else []
         text = self.run(["truth", scene, "--spp", str(spp), "--seed", str(seed), "--backend", self.backend, "-q",
                          "--transmittance", self.transmittance, "--force", "-o", out] +
-                        (["--equiangular"] if self.equiangular else []) + list(extra))
+                        (["--equiangular"] if self.equiangular else []) + strata + list(extra))
         return float(re.search(r"tracing ([0-9.eE+-]+) s", text).group(1))
 
     def render(self, scene, out, extra):
@@ -395,7 +400,10 @@ def write_markdown(rows, args, r, table_times, path, elapsed):
     out.append(f"Regenerate: `{regenerate}` "
                f"(this run: {elapsed / 60:.1f} min on {machine}, backend {args.backend}, truth with "
                f"{args.transmittance} transmittance and "
-               f"{'equiangular (MIS)' if args.equiangular else 'collision-only'} next-event estimation; "
+               f"{'equiangular (MIS)' if args.equiangular else 'collision-only'} next-event estimation"
+               + (f", up to {args.truth_strata} x {args.truth_strata} pixel-area strata per pixel (the pixel's mean, "
+                  "as the fast renderer's pixels)" if args.truth_strata > 1 else ", one ray through each pixel's "
+                  "centre") + "; "
                f"images {args.note}). The physics of the truth and how to read these numbers: "
                "[docs/truth.md](truth.md).\n")
     out.append("The fast renderer (`nebula render`) adds the light scattered *between* voxels, by default, from "
@@ -541,9 +549,14 @@ def main():
     p.add_argument("--machine", default="", help="how the report names the machine")
     p.add_argument("--note", default="64x64, grids 32^3")
     p.add_argument("--docs", default=os.path.join(ROOT, "docs"))
+    p.add_argument("--truth-strata", type=int, default=4,
+                   help="the truths' pixel-area strata per side, at most (render.samples_per_pixel; 1: the pixel's "
+                        "centre ray). The fast renderer's pixels stand for their area's mean near a star")
     p.add_argument("--from-json", default="", help="rewrite the plots and the page from a run's results.json")
     args = p.parse_args()
     args.resolutions = [tuple(int(v) for v in s.split("x")) for s in args.resolutions]
+    if args.truth_strata < 1:
+        raise SystemExit(f"--truth-strata: must be 1 or more, got {args.truth_strata}")
     start = time.time()
     if args.from_json:
         # Only the plots and the page, from a finished run's results.
@@ -551,6 +564,7 @@ def main():
             saved = json.load(f)
         r = argparse.Namespace(has_levels=saved["has_levels"])
         # What the run measured with (results from before these were saved: the command line's).
+        args.truth_strata = 1  # runs from before the strata: centre rays
         for key, value in saved.get("settings", {}).items():
             setattr(args, key, value)
         plot(saved["rows"], os.path.join(args.docs, "images"), args.backend)
@@ -569,7 +583,8 @@ def main():
         print(f"{name} ...", flush=True)
         study(r, name, args, rows, None)
     with open(os.path.join(r.work, "results.json"), "w") as f:
-        settings = {k: getattr(args, k) for k in ("backend", "transmittance", "equiangular", "default_photons")}
+        settings = {k: getattr(args, k) for k in ("backend", "transmittance", "equiangular", "default_photons",
+                                                   "truth_strata")}
         json.dump(dict(rows=rows, table_times=table_times, has_levels=r.has_levels, settings=settings,
                        elapsed=time.time() - start), f, indent=1)
     plot(rows, os.path.join(args.docs, "images"), args.backend)
