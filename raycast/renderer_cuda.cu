@@ -160,6 +160,7 @@ struct FrameBuffers {
   std::unique_ptr<DeviceArray<float>> star_rays;
   PinnedStaging staging;
   SideStream near;
+  SideStream star_rays_stream;  // the star pixels' rays: their own stream, so they run beside both march launches
 };
 thread_local FrameBuffers frame_buffers;
 
@@ -171,6 +172,21 @@ double render_cuda_to_device(const RenderInputs& in, float* pixels, unsigned lon
   const dim3 block(16, 16), grid((in.camera.width + 15) / 16, (in.camera.height + 15) / 16);
   const size_t count = scene.density.shape.count();
   const unsigned voxel_blocks = static_cast<unsigned>((count + 255) / 256);
+  // The star pixels' list, on the device before the frame's first launch: a copy after
+  // it would hold the host until the per-view pass ends, and the march's launches with it.
+  int star_rays = 0;
+  const bool exact_march = !in.mode.voxel_sources && !(in.mode.step_voxels > 0.0f);  // dispatch_march's choice
+  const std::vector<StarPixel> star_list = in.star_pixels && scene.n_stars > 0 && exact_march
+                                               ? star_pixels(in.camera, star_positions(in.stars), &star_rays)
+                                               : std::vector<StarPixel>{};
+  StarPixel* device_list = nullptr;
+  float* star_sub = nullptr;
+  if (!star_list.empty()) {
+    device_list = reused(frame_buffers.star_pixels, star_list.size());
+    NEBULA_CUDA_CHECK(
+        cudaMemcpy(device_list, star_list.data(), star_list.size() * sizeof(StarPixel), cudaMemcpyHostToDevice));
+    star_sub = reused(frame_buffers.star_rays, size_t(star_rays) * kMaxBands);
+  }
   CudaEventTimer timer;
   if (in.mode.voxel_sources) {
     // The preview: every voxel's light towards the eye, once (raycast/voxel_sources.h).
@@ -211,31 +227,29 @@ double render_cuda_to_device(const RenderInputs& in, float* pixels, unsigned lon
   dispatch_march(scene, in.mode, [&](auto smooth, auto diffuse, auto voxel_sources, auto zonal) {
     if constexpr (!smooth() && !voxel_sources()) {
       if (scene.n_stars > 0) {
-        int rays = 0;
-        const std::vector<StarPixel> list =
-            in.star_pixels ? star_pixels(in.camera, star_positions(in.stars), &rays) : std::vector<StarPixel>{};
-        StarPixel* device_list = nullptr;
-        float* sub = nullptr;
-        if (!list.empty()) {
-          device_list = reused(frame_buffers.star_pixels, list.size());
-          NEBULA_CUDA_CHECK(cudaMemcpy(device_list, list.data(), list.size() * sizeof(StarPixel), cudaMemcpyHostToDevice));
-          sub = reused(frame_buffers.star_rays, size_t(rays) * kMaxBands);
+        // The star pixels' rays first, on a stream of their own: the longest rays of the
+        // frame (the densest cells, next to the star), so they start at once and end
+        // beside the main launch instead of after the near rays.
+        SideStream& star_side = frame_buffers.star_rays_stream;
+        if (!star_list.empty()) {
+          star_side.start();
+          star_pixel_kernel<diffuse(), zonal()><<<unsigned((star_rays + 255) / 256), 256, 0, star_side.stream>>>(
+              scene, in.camera, in.mode, device_list, int(star_list.size()), star_rays, star_sub, clamps);
         }
         SideStream& side = frame_buffers.near;
         side.start();
         render_kernel<false, diffuse(), false, zonal(), RaySet::Near>
             <<<grid, block, 0, side.stream>>>(scene, in.camera, in.mode, in.exposure, pixels, clamps);
-        if (!list.empty())
-          star_pixel_kernel<diffuse(), zonal()><<<unsigned((rays + 255) / 256), 256, 0, side.stream>>>(
-              scene, in.camera, in.mode, device_list, int(list.size()), rays, sub, clamps);
         render_kernel<false, diffuse(), false, zonal(), RaySet::Far>
             <<<grid, block>>>(scene, in.camera, in.mode, in.exposure, pixels, clamps);
         side.join();
-        // After both launches: the star pixels replace their single rays.
-        if (!list.empty())
-          star_pixel_store_kernel<<<unsigned((list.size() + 127) / 128), 128>>>(
-              device_list, int(list.size()), sub, rays, scene.n_bands, in.exposure, pixels, in.camera.width,
-              in.camera.height);
+        // After every launch: the star pixels replace their single rays.
+        if (!star_list.empty()) {
+          star_side.join();
+          star_pixel_store_kernel<<<unsigned((star_list.size() + 127) / 128), 128>>>(
+              device_list, int(star_list.size()), star_sub, star_rays, scene.n_bands, in.exposure, pixels,
+              in.camera.width, in.camera.height);
+        }
         return;
       }
     }

@@ -18,6 +18,7 @@ namespace nebula::spectral {
 namespace {
 
 thread_local SideStream near_rays;  // the launch of the rays near a star (spectral_kernel)
+thread_local SideStream star_pixel_rays;  // the star pixels' rays, on their own beside both launches
 
 // kNear: the rays passes_near_a_star picks (the phase's mean over their
 // chords' angles), else the others; a launch of each marches every pixel once.
@@ -262,15 +263,21 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
   dispatch_method(m.settings.method, [&](auto method) {
     with_accumulators<method()>(view, [&](auto acc) {
       if (view.n_stars > 0) {
+        // The star pixels' rays first, on a stream of their own: the frame's longest rays,
+        // so they end beside the main launch rather than after the near rays.
+        if (!list.empty()) {
+          star_pixel_rays.start();
+          spectral_star_pixel_kernel<method(), decltype(acc)>
+              <<<unsigned((rays + 127) / 128), 128, 0, star_pixel_rays.stream>>>(
+                  view, in.camera, device_list.get(), int(list.size()), rays, m.planes(), sub.get());
+        }
         near_rays.start();
         spectral_kernel<method(), decltype(acc), true>
             <<<grid, block, 0, near_rays.stream>>>(view, in.camera, pixels.get());
-        if (!list.empty())
-          spectral_star_pixel_kernel<method(), decltype(acc)><<<unsigned((rays + 127) / 128), 128, 0, near_rays.stream>>>(
-              view, in.camera, device_list.get(), int(list.size()), rays, m.planes(), sub.get());
         spectral_kernel<method(), decltype(acc), false><<<grid, block>>>(view, in.camera, pixels.get());
         near_rays.join();
-        if (!list.empty())  // after both launches: the star pixels replace their single rays
+        if (!list.empty()) star_pixel_rays.join();
+        if (!list.empty())  // after every launch: the star pixels replace their single rays
           spectral_star_pixel_store_kernel<<<unsigned((list.size() + 127) / 128), 128>>>(
               device_list.get(), int(list.size()), sub.get(), rays, m.planes(), pixels.get(), in.camera.width,
               in.camera.height);
