@@ -136,6 +136,8 @@ def render_file(nebula, arguments, h5, what, reuse):
             if f.read() == wanted:
                 print(f"  reusing {h5}", flush=True)
                 return
+    if os.path.exists(record):
+        os.remove(record)  # until the new render is in place, no record may vouch for the file
     run([nebula] + arguments, what)
     with open(record + ".tmp", "w") as f:
         f.write(wanted)
