@@ -51,8 +51,10 @@ TEST(AxialDiffuse, VoxelizationKeepsTheDust) {
 // albedo 1: all the light that interacts leaves, 1 / (4 pi) of it per unit
 // solid angle by the symmetry, so the image plane integral from any side is
 // power (1 - <exp(-tau)>) / (4 pi). Allowed as for the grid (raycast/
-// diffuse_render_test.cpp): the stated 5% at tau <= 1 plus 4 standard errors
-// of the photon sum; without the field the image must miss by more.
+// diffuse_render_test.cpp): the stated 2% plus 4 standard errors of the
+// photon sum and of the table (the tabulator's, as the renderer's tables are:
+// the thin-limit one scatters 2% too much light at this texel's tau_sct);
+// without the field the image must miss by more.
 TEST(AxialDiffuse, ConservesEnergyAtAlbedoOne) {
   const int n = 24;
   const float texel = 0.05f, R = n * texel, tau_radial = 1.0f;
@@ -87,7 +89,8 @@ TEST(AxialDiffuse, ConservesEnergyAtAlbedoOne) {
     escape += std::exp(-tau) / n_dirs;
   }
   for (float g : {0.0f, 0.6f}) {
-    const ScatteringTable table = thin_table(g);
+    double table_error = 0;
+    const ScatteringTable table = testing::table_at_albedo_one(g, tau_radial / n, &table_error);
     const float power = 1000.0f;
     AxialRenderInputs in;
     in.map = &map;
@@ -123,7 +126,7 @@ TEST(AxialDiffuse, ConservesEnergyAtAlbedoOne) {
     in.diffuse = &field;
     const double with = total(render_axial_cpu(in, nullptr));
     const double expected = power * (1 - escape) / (4 * kPiD);
-    const double allowed = 0.05 + 4 / std::sqrt(double(o.photons));
+    const double allowed = 0.02 + 4 * std::sqrt(1.0 / double(o.photons) + table_error * table_error);
     std::printf("g %.1f: scattered light %.4g, expected %.4g (ratio %.4f, allowed +-%.3f); without the field %.4f; "
                 "bake grid %dx%dx%d, field %dx%d cells\n",
                 g, with, expected, with / expected, allowed, without / expected, stats.grid.nx, stats.grid.ny,
