@@ -37,7 +37,7 @@ void run_animate(const Options& o) {
   a.existing_hint = ": --resume finishes that run, --force renders every frame again";
   a.video = o.video;
   a.render.backend = parse_backend(o.backend);
-  a.render.table_photons = parse_count("--table-photons", o.table_photons, 1000, double(kMaxPhotonsPerRow));
+  a.render.table_photons = parse_count("--table-photons", o.table_photons, 1000, double(kMaxBasePhotons));
   a.render.smooth_step = o.smooth;
   a.render.progress = !o.quiet;
   a.progress = !o.quiet;
@@ -84,7 +84,7 @@ void add_animate_command(CLI::App& app) {
   cmd->add_option("--backend", o->backend, "cpu, cuda or auto")->capture_default_str();
   cmd->add_option("--smooth", o->smooth, "smooth display mode: trilinear fields at this step in voxels (0: exact)")
       ->capture_default_str();
-  cmd->add_option("--table-photons", o->table_photons, "photons per row for tables generated on first use")
+  cmd->add_option("--table-photons", o->table_photons, "photons per row for tables generated on first use (rows of tau_sct < 1 trace up to 32 times more; docs/tabulator.md)")
       ->capture_default_str();
   cmd->add_flag("--resume", o->resume, "keep the frames an interrupted run of the same path finished");
   cmd->add_flag("--force", o->force, "render every frame again over existing ones (and overwrite the video)");

@@ -34,7 +34,7 @@ void run_render(const Options& o) {
   check_run_memory(scene, RunKind::Fast);
   RenderOptions options;
   options.backend = parse_backend(o.backend);
-  options.table_photons = parse_count("--table-photons", o.table_photons, 1000, double(kMaxPhotonsPerRow));
+  options.table_photons = parse_count("--table-photons", o.table_photons, 1000, double(kMaxBasePhotons));
   options.smooth_step = o.smooth;
   options.progress = !o.quiet;
   OptionNames names{{"smooth_step", "--smooth"}, {"backend", "--backend"}};
@@ -60,7 +60,7 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--levels", o->levels,
                   "multiple scattering by the 2005 paper's resolution pyramid with this many coarser levels, instead "
                   "of the diffuse field (default: the scene's render.levels, 0)");
-  cmd->add_option("--table-photons", o->table_photons, "photons per row for tables generated on first use")
+  cmd->add_option("--table-photons", o->table_photons, "photons per row for tables generated on first use (rows of tau_sct < 1 trace up to 32 times more; docs/tabulator.md)")
       ->capture_default_str();
   cmd->add_flag("--force", o->force, "overwrite an existing output");
   cmd->add_flag("-q,--quiet", o->quiet, "no progress bars");

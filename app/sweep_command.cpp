@@ -91,7 +91,7 @@ void run_sweep_command(const Options& o) {
   if (o.height != -1) overrides.push_back("camera.height=" + std::to_string(o.height));
   RenderOptions options;
   options.backend = parse_backend(o.backend);
-  options.table_photons = parse_count("--table-photons", o.table_photons, 1000, double(kMaxPhotonsPerRow));
+  options.table_photons = parse_count("--table-photons", o.table_photons, 1000, double(kMaxBasePhotons));
   RenderSession session = RenderSession::from_file(o.scene, overrides, options);
   check_not_an_input("-o", o.out, session.load().inputs);
   SweepOptions so;
@@ -175,7 +175,7 @@ void add_sweep_command(CLI::App& app) {
   cmd->add_option("--spp", o->spp, "with --truth: samples per pixel and band")->capture_default_str();
   cmd->add_option("--seed", o->seed, "with --truth: the random seed")->capture_default_str();
   cmd->add_option("--backend", o->backend, "cpu, cuda or auto")->capture_default_str();
-  cmd->add_option("--table-photons", o->table_photons, "photons per row for tables generated on first use")
+  cmd->add_option("--table-photons", o->table_photons, "photons per row for tables generated on first use (rows of tau_sct < 1 trace up to 32 times more; docs/tabulator.md)")
       ->capture_default_str();
   cmd->add_flag("--separate-photons", o->separate_photons,
                 "every point bakes its diffuse field from photons of its own (each plane then equals a separate "

@@ -60,18 +60,19 @@ void run_tabulate(const TabulateParams& p, const std::string& backend_name, cons
   const Backend backend = parse_backend(backend_name);
   std::unique_ptr<Progress> progress;
   if (!quiet)
-    progress = std::make_unique<Progress>("tabulate", p.photons_per_row * p.tau_bins);
+    progress = std::make_unique<Progress>("tabulate", photons_of_table(p));
   const Tabulation tab = tabulate(p, backend, progress.get());
   if (progress) progress->finish();
   const ScatteringTable table = to_table(tab);
   write_table(table, out, force);
 
-  const double photons = double(p.photons_per_row) * p.tau_bins;
+  const double photons = double(photons_of_table(p));
   std::printf("P(tau, mu) table: %d tau_sct x %d %s bins, tau_sct in [0, %g], albedo %g, g %g, %s beam\n",
               p.tau_bins, p.mu_bins, to_string(p.binning), p.tau_max, p.albedo, p.g,
               to_string(p.beam));
-  std::printf("photons: %.3g (%.3g per row), scattering events %.3g, capped by the order limit %llu\n",
-              photons, double(p.photons_per_row), double(tab.scattering_events),
+  std::printf("photons: %.3g (%.3g per row, rows of tau_sct < 1 up to %d times more), scattering events %.3g, "
+              "capped by the order limit %llu\n",
+              photons, double(p.photons_per_row), p.thin_boost, double(tab.scattering_events),
               static_cast<unsigned long long>(tab.capped_photons));
   std::printf("time: %.3f s on %s: %.3g photons/s, %.3g events/s\n", tab.seconds,
               tab.device.c_str(), photons / tab.seconds, tab.scattering_events / tab.seconds);
@@ -101,6 +102,9 @@ void add_tabulate_command(CLI::App& app) {
   cmd->add_option("--binning", o->binning, "uniform-mu (the paper's) or uniform-theta (resolves forward peaks)")
       ->capture_default_str();
   cmd->add_option("--photons", o->photons, "photons per row (1e3 ... 2^30)")->capture_default_str();
+  cmd->add_option("--thin-boost", o->p.thin_boost,
+                  "rows of tau_sct < 1 trace photons x min(this, floor(1 / tau_sct)) (1: the same in every row)")
+      ->capture_default_str();
   cmd->add_option("--seed", o->p.seed, "Philox key: same seed, same table")->capture_default_str();
   cmd->add_option("--illumination", o->illumination,
                   "parallel (beam over the cross-section) or pencil (the paper's ray through the centre)")
@@ -120,7 +124,8 @@ void add_tabulate_command(CLI::App& app) {
     else throw Error("--illumination: expected parallel or pencil, got '" + o->illumination + "'");
     p.forced_first_scattering = !o->analog;
     naming_options({{"albedo", "--albedo"}, {"g", "--g"}, {"tau_max", "--tau-max"}, {"tau_bins", "--tau-bins"},
-                    {"mu_bins", "--mu-bins"}, {"photons_per_row", "--photons"}, {"backend", "--backend"}},
+                    {"mu_bins", "--mu-bins"}, {"photons_per_row", "--photons"}, {"thin_boost", "--thin-boost"},
+                    {"backend", "--backend"}},
                    [&] { run_tabulate(p, o->backend, o->out, o->force, o->quiet); });
   });
 }
@@ -140,9 +145,11 @@ void add_table_command(CLI::App& app) {
                 t.phase.c_str(), t.geometry.c_str(), t.illumination.c_str());
     std::printf("axes: %d tau_sct in [0, %g]; %d %s bins of cos(theta)\n", t.n_tau(), t.tau_max(),
                 t.n_mu(), to_string(t.mu_binning));
-    std::printf("Monte Carlo: %llu photons per row, seed %llu, %s, forced first scattering %s,\n"
+    std::printf("Monte Carlo: %llu photons per row (rows of tau_sct < 1: up to %llu times more), seed %llu, %s, "
+                "forced first scattering %s,\n"
                 "  roulette below %g (survival %g), order cap %d (%llu photons capped), %.3g events\n",
-                (unsigned long long)t.photons_per_row, (unsigned long long)t.seed, t.rng.c_str(),
+                (unsigned long long)t.photons_per_row, (unsigned long long)t.thin_boost, (unsigned long long)t.seed,
+                t.rng.c_str(),
                 t.forced_first_scattering ? "on" : "off", t.roulette_threshold, t.roulette_survival,
                 t.max_orders, (unsigned long long)t.capped_photons, double(t.scattering_events));
     print_error_summary(t);

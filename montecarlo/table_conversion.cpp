@@ -13,6 +13,7 @@ ScatteringTable to_table(const Tabulation& t) {
   table.g = p.g;
   table.illumination = to_string(p.beam);
   table.photons_per_row = p.photons_per_row;
+  table.thin_boost = uint64_t(p.thin_boost);
   table.seed = p.seed;
   table.generator = kGenerator;
   table.forced_first_scattering = p.forced_first_scattering;

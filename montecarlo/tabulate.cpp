@@ -28,6 +28,11 @@ void validate(const TabulateParams& p) {
     throw ParameterError("tau_bins", to_text(p.tau_bins) + " rows of " + to_text(p.mu_bins) + " bins " + over);
   if (p.photons_per_row < 2 || p.photons_per_row > kMaxPhotonsPerRow)
     throw ParameterError("photons_per_row", "need 2 to 2^30 photons per row, got " + to_text(double(p.photons_per_row)));
+  if (p.thin_boost < 1 || p.thin_boost > kMaxThinBoost)
+    throw ParameterError("thin_boost", "must be 1 to " + to_text(kMaxThinBoost) + ", got " + to_text(p.thin_boost));
+  if (double(p.photons_per_row) * p.thin_boost > double(kMaxPhotonsPerRow))
+    throw ParameterError("photons_per_row", to_text(double(p.photons_per_row)) + " photons per row x thin_boost " +
+                                                to_text(p.thin_boost) + " is more than 2^30 in a thin row");
   if (!(p.roulette.threshold > 0 && p.roulette.threshold < 1) ||
       !(p.roulette.survival > 0 && p.roulette.survival <= 1) || p.roulette.max_orders < 1)
     throw ParameterError("roulette", "threshold in (0, 1), survival in (0, 1] and max orders >= 1 required");
@@ -38,6 +43,20 @@ void validate(const TabulateParams& p) {
 
 double tau_of_row(const TabulateParams& p, int row) {
   return p.tau_max * row / (p.tau_bins - 1);
+}
+
+uint64_t photons_of_row(const TabulateParams& p, int row) {
+  const double tau = tau_of_row(p, row);
+  // floor(1 / tau) without the division's overflow at tau = 0; the 1e-9 keeps
+  // rows like 0.05, whose double is a hair above 1/20, at 20.
+  const double boost = tau * p.thin_boost >= 1.0 ? std::floor(1.0 / tau + 1e-9) : double(p.thin_boost);
+  return p.photons_per_row * static_cast<uint64_t>(std::fmax(1.0, boost));
+}
+
+uint64_t photons_of_table(const TabulateParams& p) {
+  uint64_t n = 0;
+  for (int i = 0; i < p.tau_bins; ++i) n += photons_of_row(p, i);
+  return n;
 }
 
 double weight_scale(const TabulateParams& p, int row) {
@@ -58,6 +77,7 @@ SphereRow make_sphere_row(const TabulateParams& p, int row) {
   r.stream = {p.seed, static_cast<uint32_t>(row), kPurposeSphere};
   r.bins = {p.binning, p.mu_bins};
   r.forced_first = p.forced_first_scattering;
+  r.photons = static_cast<uint32_t>(photons_of_row(p, row));
   const double scale = weight_scale(p, row);
   r.inv_weight_scale = scale > 0 ? static_cast<float>(1.0 / scale) : 0.0f;
   return r;
@@ -79,7 +99,6 @@ Tabulation finish_tabulation(const TabulateParams& p, const SphereTallies& t) {
   out.params = p;
   const int n_tau = p.tau_bins, n_mu = p.mu_bins;
   const AngularBins bins{p.binning, n_mu};
-  const double n = static_cast<double>(p.photons_per_row);
   // P = (pi R^2 / l^2) F: light per steradian per unit face area (DESIGN.md).
   const double cross_section = kPiD * kVoxelSphereRadius * kVoxelSphereRadius;
   out.tau.resize(n_tau);
@@ -90,6 +109,7 @@ Tabulation finish_tabulation(const TabulateParams& p, const SphereTallies& t) {
   out.unscattered.assign(n_tau, 0.0);
   for (int i = 0; i < n_tau; ++i) {
     out.tau[i] = tau_of_row(p, i);
+    const double n = static_cast<double>(photons_of_row(p, i));
     const double scale = weight_scale(p, i);
     double s1_row = 0, s2_row = 0;
     for (int k = 0; k < n_mu; ++k) {
@@ -125,7 +145,7 @@ Tabulation tabulate(const TabulateParams& p, Backend backend, Progress* progress
   if (p.albedo == 0.0) {
     tallies.resize(p.tau_bins, p.mu_bins);
     for (int i = 0; i < p.tau_bins; ++i)
-      tallies.unscattered[i] = to_fixed(1.0f) * p.photons_per_row;
+      tallies.unscattered[i] = to_fixed(1.0f) * photons_of_row(p, i);
   } else if (backend == Backend::Cuda) {
     tallies = tabulate_sphere_cuda(p, progress);
   } else {

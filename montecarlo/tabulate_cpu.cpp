@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <vector>
@@ -39,18 +40,22 @@ struct CpuSphereSink {
 SphereTallies tabulate_sphere_cpu(const TabulateParams& p, Progress* progress) {
   SphereTallies t;
   t.resize(p.tau_bins, p.mu_bins);
-  const uint64_t chunks_per_row = (p.photons_per_row + kChunk - 1) / kChunk;
   std::vector<SphereRow> rows(p.tau_bins);
   for (int i = 0; i < p.tau_bins; ++i) rows[i] = make_sphere_row(p, i);
-  const uint64_t tasks = chunks_per_row * p.tau_bins;
+  // Tasks of kChunk photons, the heaviest (largest tau) rows first, for a short
+  // tail: first_task[j] is the first task of the j-th row in that order.
+  std::vector<uint64_t> first_task(p.tau_bins + 1, 0);
+  for (int j = 0; j < p.tau_bins; ++j)
+    first_task[j + 1] = first_task[j] + (rows[p.tau_bins - 1 - j].photons + kChunk - 1) / kChunk;
+  const uint64_t tasks = first_task.back();
   const auto start = std::chrono::steady_clock::now();
   tbb::parallel_for(tbb::blocked_range<uint64_t>(0, tasks, 1), [&](const auto& range) {
     for (uint64_t task = range.begin(); task != range.end(); ++task) {
-      // Heaviest (largest tau) rows first, for a short tail.
-      const int i = p.tau_bins - 1 - static_cast<int>(task / chunks_per_row);
-      const uint64_t begin = (task % chunks_per_row) * kChunk;
-      const uint64_t end = std::min(begin + kChunk, p.photons_per_row);
+      const int j = static_cast<int>(std::upper_bound(first_task.begin(), first_task.end(), task) - first_task.begin()) - 1;
+      const int i = p.tau_bins - 1 - j;
       const SphereRow& row = rows[i];
+      const uint64_t begin = (task - first_task[j]) * kChunk;
+      const uint64_t end = std::min<uint64_t>(begin + kChunk, row.photons);
       CpuSphereSink sink(p.mu_bins);
       uint64_t unscattered = 0, events = 0;
       for (uint64_t photon = begin; photon < end; ++photon) {

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <utility>
 
 #include "core/error.h"
 #include "core/math.h"
@@ -115,6 +117,49 @@ TEST(Tabulate, VarianceReductionIsUnbiased) {
   EXPECT_LT(forced.total_stderr[1], analog.total_stderr[1]);
 }
 
+// Rows of tau_sct < 1 trace photons_per_row x min(thin_boost, floor(1 / tau))
+// photons, rows from tau_sct = 1 on photons_per_row: the same estimator with
+// more photons, so the same expectation and a standard error smaller by the
+// square root of the boost.
+TEST(Tabulate, ThinRowsGetMorePhotons) {
+  TabulateParams p;
+  p.tau_max = 10;
+  p.tau_bins = 1001;  // rows 0.01 apart
+  p.photons_per_row = 1000;
+  const std::pair<int, uint64_t> expected[] = {{0, 32}, {1, 32}, {3, 32}, {4, 25}, {5, 20}, {10, 10},
+                                               {30, 3}, {99, 1}, {100, 1}, {1000, 1}};
+  for (const auto& [row, boost] : expected) EXPECT_EQ(photons_of_row(p, row), 1000 * boost) << "row " << row;
+  p.thin_boost = 1;
+  EXPECT_EQ(photons_of_row(p, 1), 1000u);
+  EXPECT_EQ(photons_of_table(p), 1001u * 1000u);
+
+  // Row tau_sct = 0.1 (10 times the photons) against the same row without the boost.
+  TabulateParams q;
+  q.albedo = 0.6;
+  q.g = 0.9;
+  q.tau_max = 0.1;
+  q.tau_bins = 2;
+  q.mu_bins = 72;
+  q.binning = AngularBinning::UniformTheta;
+  q.photons_per_row = 20000;
+  q.thin_boost = 1;
+  const Tabulation plain = tabulate(q, Backend::Cpu);
+  q.thin_boost = 32;
+  q.seed = 2;  // independent photons
+  const Tabulation boosted = tabulate(q, Backend::Cpu);
+  const double ratio = plain.total_stderr[1] / boosted.total_stderr[1];
+  EXPECT_GT(ratio, std::sqrt(10.0) * 0.8) << "the boosted row's standard error should be sqrt(10) times smaller";
+  EXPECT_LT(ratio, std::sqrt(10.0) * 1.25);
+  EXPECT_NEAR(boosted.total[1], plain.total[1], 4 * std::hypot(plain.total_stderr[1], boosted.total_stderr[1]));
+  int beyond = 0;
+  for (int k = 0; k < q.mu_bins; ++k) {
+    const size_t e = size_t(q.mu_bins) + size_t(k);
+    const double s = std::hypot(plain.P_stderr[e], boosted.P_stderr[e]);
+    if (std::fabs(boosted.P[e] - plain.P[e]) > 4 * s) ++beyond;
+  }
+  EXPECT_LE(beyond, 1) << "bins beyond 4 standard errors of the unboosted row";
+}
+
 TEST(Tabulate, RefusesBadParametersNamingTheField) {
   // The field's name, never a command-line option: front ends reword it.
   auto parameter = [](TabulateParams p) {
@@ -147,6 +192,16 @@ TEST(Tabulate, RefusesBadParametersNamingTheField) {
   p = {};
   p.photons_per_row = 0;
   EXPECT_EQ(parameter(p), "photons_per_row");
+  p = {};
+  p.thin_boost = 0;
+  EXPECT_EQ(parameter(p), "thin_boost");
+  p.thin_boost = kMaxThinBoost + 1;
+  EXPECT_EQ(parameter(p), "thin_boost");
+  p = {};
+  p.photons_per_row = kMaxBasePhotons + 1;  // too many in a thin row
+  EXPECT_EQ(parameter(p), "photons_per_row");
+  p.thin_boost = 1;
+  EXPECT_EQ(parameter(p), "accepted");
   EXPECT_EQ(parameter(TabulateParams{}), "accepted");
 }
 

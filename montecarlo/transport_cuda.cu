@@ -53,17 +53,18 @@ struct SharedSphereSink {
 // stay busy although photons live for very different numbers of steps, and
 // every step runs the same code (transport_step) for every lane.
 __global__ void __launch_bounds__(kThreads, NEBULA_SPHERE_MIN_BLOCKS)
-    sphere_kernel(const SphereRow* rows, int row_end, uint32_t photons, int n_mu, ull* sum_w,
-                  ull* sum_w2, ull* scalars) {
+    sphere_kernel(const SphereRow* rows, int row_end, int n_mu, ull* sum_w, ull* sum_w2, ull* scalars) {
   extern __shared__ ull hist[];
   __shared__ uint32_t next_photon;
+  const int i = row_end - 1 - static_cast<int>(blockIdx.y);
+  const SphereRow row = rows[i];
+  // Rows differ in photons (thin rows more): blocks past a row's count leave.
   const uint32_t begin = blockIdx.x * kSpherePhotonsPerBlock;
-  const uint32_t end = min(photons, begin + kSpherePhotonsPerBlock);
+  if (begin >= row.photons) return;
+  const uint32_t end = min(row.photons, begin + kSpherePhotonsPerBlock);
   for (int k = threadIdx.x; k < 2 * n_mu; k += blockDim.x) hist[k] = 0;
   if (threadIdx.x == 0) next_photon = begin;
   __syncthreads();
-  const int i = row_end - 1 - static_cast<int>(blockIdx.y);
-  const SphereRow row = rows[i];
   SharedSphereSink sink{hist, n_mu};
   ull unscattered = 0, events = 0;
   PhotonState st;
@@ -121,20 +122,23 @@ SphereTallies tabulate_sphere_cuda(const TabulateParams& p, Progress* progress) 
   const size_t shared = 2 * n_mu * sizeof(ull);
   NEBULA_CUDA_CHECK(cudaFuncSetAttribute(sphere_kernel, cudaFuncAttributeMaxDynamicSharedMemorySize,
                                          static_cast<int>(shared)));
-  const auto photons = static_cast<uint32_t>(p.photons_per_row);
-  const uint32_t chunks = (photons + kSpherePhotonsPerBlock - 1) / kSpherePhotonsPerBlock;
+  uint32_t most = 0;
+  for (const SphereRow& r : host_rows) most = std::max(most, r.photons);
+  const uint32_t chunks = (most + kSpherePhotonsPerBlock - 1) / kSpherePhotonsPerBlock;
   // With a progress bar, launch ~20 slices of rows and report after each;
   // without one, a single launch (no tail between slices).
   const int rows_per_launch = progress ? std::max(1, (n_tau + 19) / 20) : n_tau;
   CudaEventTimer timer;
   for (int row_end = n_tau; row_end > 0; row_end -= rows_per_launch) {
     const int count = std::min(rows_per_launch, row_end);
-    sphere_kernel<<<dim3(chunks, count), kThreads, shared>>>(rows.get(), row_end, photons, n_mu,
-                                                              sum_w.get(), sum_w2.get(), scalars.get());
+    sphere_kernel<<<dim3(chunks, count), kThreads, shared>>>(rows.get(), row_end, n_mu, sum_w.get(), sum_w2.get(),
+                                                              scalars.get());
     NEBULA_CUDA_CHECK(cudaGetLastError());
     if (progress) {
       NEBULA_CUDA_CHECK(cudaDeviceSynchronize());
-      progress->add(uint64_t(count) * photons);
+      uint64_t done = 0;
+      for (int i = row_end - count; i < row_end; ++i) done += host_rows[i].photons;
+      progress->add(done);
     }
   }
   const double transport_seconds = timer.seconds();

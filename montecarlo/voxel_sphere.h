@@ -43,6 +43,7 @@ struct SphereRow {
   AngularBins bins;
   bool forced_first;
   float inv_weight_scale;  // tallies hold weight / scale, kept in [0, 2)
+  uint32_t photons;        // traced in this row (photons_of_row)
 };
 
 NEBULA_HD Fate sphere_step(const SphereRow& row, uint32_t photon, PhotonState& st,

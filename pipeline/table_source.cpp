@@ -62,6 +62,8 @@ std::string mismatch(const ScatteringTable& t, const TabulateParams& p) {
   if (t.illumination != to_string(p.beam)) return differs("illumination", t.illumination, to_string(p.beam));
   if (t.photons_per_row != p.photons_per_row)
     return differs("photons_per_row", std::to_string(t.photons_per_row), std::to_string(p.photons_per_row));
+  if (t.thin_boost != uint64_t(p.thin_boost))
+    return differs("thin_boost", std::to_string(t.thin_boost), std::to_string(p.thin_boost));
   if (t.seed != p.seed) return differs("seed", std::to_string(t.seed), std::to_string(p.seed));
   if (t.forced_first_scattering != p.forced_first_scattering || t.roulette_threshold != p.roulette.threshold ||
       t.roulette_survival != p.roulette.survival || t.max_orders != p.roulette.max_orders)
@@ -74,7 +76,8 @@ std::string mismatch(const ScatteringTable& t, const TabulateParams& p) {
 std::string table_cache_name(const TabulateParams& p) {
   return "hg_a" + exact_text(p.albedo) + "_g" + exact_text(p.g) + "_tau" + exact_text(p.tau_max) + "x" +
          std::to_string(p.tau_bins) + "_" + to_string(p.binning) + std::to_string(p.mu_bins) + "_" +
-         to_string(p.beam) + "_n" + std::to_string(p.photons_per_row) + "_s" + std::to_string(p.seed) + ".h5";
+         to_string(p.beam) + "_n" + std::to_string(p.photons_per_row) + "_b" + std::to_string(p.thin_boost) + "_s" +
+         std::to_string(p.seed) + ".h5";
 }
 
 ScatteringTable cached_table(const TabulateParams& p, Backend backend, bool progress, TableOrigin* origin,
@@ -116,7 +119,7 @@ ScatteringTable cached_table(const TabulateParams& p, Backend backend, bool prog
   if (progress)
     bar = std::make_unique<Progress>("table a=" + std::to_string(p.albedo).substr(0, 4) +
                                          " g=" + std::to_string(p.g).substr(0, 5),
-                                     p.photons_per_row * p.tau_bins);
+                                     photons_of_table(p));
   const ScatteringTable table = to_table(tabulate(p, backend, bar.get()));
   if (bar) bar->finish();
   try {

@@ -151,7 +151,7 @@ TEST_F(TableSource, UnwritableCacheFailsBeforeTheWork) {
     if (::geteuid() == 0 && (::setgid(65534) != 0 || ::setuid(65534) != 0)) ::_exit(3);
     setenv("NEBULA_CACHE_DIR", cache.c_str(), 1);
     TabulateParams p;
-    p.photons_per_row = kMaxPhotonsPerRow;
+    p.photons_per_row = kMaxBasePhotons;
     try {
       cached_table(p, Backend::Cpu, false, nullptr, nullptr);
     } catch (const Error& e) {

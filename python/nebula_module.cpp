@@ -155,8 +155,8 @@ class PySession {
             bool is_text, const std::string& base_dir) {
     RenderOptions o;
     o.backend = backend_of(backend);
-    if (!(table_photons >= 1000 && table_photons <= double(kMaxPhotonsPerRow)))
-      throw py::value_error("table_photons: must be 1000 to 2^30");
+    if (!(table_photons >= 1000 && table_photons <= double(kMaxBasePhotons)))
+      throw py::value_error("table_photons: must be 1000 to 2^25 (rows of tau_sct < 1 trace up to 32 times more)");
     o.table_photons = uint64_t(table_photons);
     const std::vector<std::string> overrides = overrides_of(set);
     session_ = std::make_unique<RenderSession>(

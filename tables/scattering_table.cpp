@@ -124,6 +124,7 @@ void ScatteringTable::check_consistency(const std::string& source) const {
   if (!(albedo >= 0.0 && albedo <= 1.0)) c.fail("albedo", "a value in [0, 1]", number(albedo));
   if (!(std::fabs(g) < 1.0)) c.fail("g", "a value with |g| < 1", number(g));
   if (photons_per_row < 1) c.fail("photons_per_row", ">= 1", "0");
+  if (thin_boost < 1) c.fail("thin_boost", ">= 1", "0");
   if (!std::isfinite(roulette_threshold) || roulette_threshold < 0.0)
     c.fail("roulette_threshold", "a finite value >= 0", number(roulette_threshold));
   if (!std::isfinite(roulette_survival) || roulette_survival < 0.0)

@@ -21,7 +21,8 @@ struct ScatteringTable {
   std::string geometry = "sphere";
   std::string illumination = "parallel";  // or "pencil"
   AngularBinning mu_binning = AngularBinning::UniformMu;
-  uint64_t photons_per_row = 0;
+  uint64_t photons_per_row = 0;  // rows of tau_sct >= 1; thinner ones x min(thin_boost, floor(1 / tau_sct))
+  uint64_t thin_boost = 1;       // 1 in files written before it existed (no attribute)
   uint64_t seed = 0;
   std::string rng = "philox4x32-10";
   int schema_version = 1;

@@ -123,6 +123,7 @@ void write_hdf5(const ScatteringTable& t, const std::string& file_name) {
   write_string_attribute(f, "rng", t.rng);
   write_string_attribute(f, "generator", t.generator);
   u64("photons_per_row", t.photons_per_row);
+  u64("thin_boost", t.thin_boost);
   u64("seed", t.seed);
   u64("capped_photons", t.capped_photons);
   u64("scattering_events", t.scattering_events);
@@ -198,6 +199,8 @@ class Reader {
     if (H5Aread(attr.get(), H5T_NATIVE_DOUBLE, &v) < 0) fail(name, expected, with_reason("a read error"));
     return v;
   }
+
+  bool has_attribute(const char* name) const { return H5Aexists(file_, name) > 0; }
 
   uint64_t attribute_u64(const char* name) const {
     const std::string expected = "a scalar non-negative integer (uint64) attribute";
@@ -323,6 +326,8 @@ ScatteringTable read_hdf5(const std::string& path, hid_t file) {
   t.rng = r.attribute_string("rng");
   t.generator = r.attribute_string("generator");
   t.photons_per_row = r.attribute_u64("photons_per_row");
+  // Files from before thin rows got more photons have no such attribute: 1.
+  t.thin_boost = r.has_attribute("thin_boost") ? r.attribute_u64("thin_boost") : 1;
   t.seed = r.attribute_u64("seed");
   t.capped_photons = r.attribute_u64("capped_photons");
   t.scattering_events = r.attribute_u64("scattering_events");

@@ -36,6 +36,7 @@ void expect_same_table(const ScatteringTable& a, const ScatteringTable& b) {
   EXPECT_EQ(a.illumination, b.illumination);
   EXPECT_EQ(a.mu_binning, b.mu_binning);
   EXPECT_EQ(a.photons_per_row, b.photons_per_row);
+  EXPECT_EQ(a.thin_boost, b.thin_boost);
   EXPECT_EQ(a.seed, b.seed);
   EXPECT_EQ(a.rng, b.rng);
   EXPECT_EQ(a.schema_version, b.schema_version);
@@ -340,6 +341,21 @@ TEST_F(RefusedFile, NegativeSeed) {
 TEST_F(RefusedFile, MissingAttribute) {
   expect_refused([](Editor& e) { e.remove_attribute("photons_per_row"); },
                  {"photons_per_row: expected", "no such attribute"});
+}
+
+// Tables written before thin rows got more photons have no thin_boost: they
+// read as 1 (the same photons in every row); a 0 is refused.
+TEST_F(RefusedFile, MissingThinBoostReadsAsOneAndZeroIsRefused) {
+  const std::string file = path("old.h5");
+  write_table(table_, file, true);
+  {
+    Editor editor(file);
+    editor.remove_attribute("thin_boost");
+  }
+  EXPECT_EQ(read_table(file).thin_boost, 1u);
+  const unsigned long long zero = 0;
+  expect_refused([&](Editor& e) { e.set_attribute("thin_boost", H5T_NATIVE_ULLONG, &zero); },
+                 {"thin_boost: expected", ">= 1"});
 }
 
 TEST_F(RefusedFile, UnknownBinning) {

@@ -34,6 +34,7 @@ inline ScatteringTable make_test_table(double tau_max = 5.0, int n_tau = 11,
   t.g = g;
   t.illumination = "parallel";
   t.photons_per_row = 1000003;
+  t.thin_boost = 17;
   t.seed = 0xFEDCBA9876543210ull;  // high bit set: uint64 must survive
   t.generator = "nebula-test 0.1.0";
   t.forced_first_scattering = true;

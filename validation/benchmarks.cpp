@@ -44,7 +44,7 @@ ThroughputResult bench_throughput(Backend backend, const TabulateParams& p, int 
   }
   r.median_seconds = median_of(compute);
   r.median_wall = median_of(wall);
-  const double photons = double(p.photons_per_row) * p.tau_bins;
+  const double photons = double(photons_of_table(p));
   r.photons_per_second = photons / r.median_seconds;
   r.events_per_second = double(events) / r.median_seconds;
   r.events_per_photon = double(events) / photons;
@@ -55,7 +55,8 @@ std::vector<ConvergenceRow> bench_convergence(Backend backend, const TabulatePar
                                               const std::vector<uint64_t>& counts, int ref_factor) {
   TabulateParams ref_params = base;
   ref_params.photons_per_row =
-      std::min<uint64_t>(*std::max_element(counts.begin(), counts.end()) * ref_factor, kMaxPhotonsPerRow);
+      std::min<uint64_t>(*std::max_element(counts.begin(), counts.end()) * ref_factor,
+                        kMaxPhotonsPerRow / uint64_t(base.thin_boost));
   ref_params.seed = base.seed + 1000003;  // independent of every run below
   const Tabulation ref = tabulate(ref_params, backend);
   double ref_norm = 0;

@@ -940,7 +940,7 @@ int main(int argc, char** argv) {
   app.add_option("--save-map", a.save_map, "automation: the (painted) map to HDF5, as [axial] file reads it");
   app.add_flag("--force", a.force, "overwrite existing outputs");
   app.add_flag("--show-panels", a.show_panels, "automation: keep the interface in the window shot");
-  app.add_option("--table-photons", a.table_photons, "photons per row for tables generated on first use")
+  app.add_option("--table-photons", a.table_photons, "photons per row for tables generated on first use (rows of tau_sct < 1 trace up to 32 times more; docs/tabulator.md)")
       ->capture_default_str();
   try {
     app.parse(argc, argv);
