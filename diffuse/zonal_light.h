@@ -42,7 +42,8 @@ NEBULA_HD Pair load_pair(const float* p) {
 template <int kDeg, class Scene>
 NEBULA_HD bool zonal_scattered_light(const Scene& s, const DiffuseView& f, float tau_v, size_t cell,
                                      Vec3 point, Vec3 to_eye, const float (&D)[kMaxBands][kDeg + 1],
-                                     float (&light)[kMaxBands], float (&peak)[kMaxBands], int deg = kDeg) {
+                                     float (&light)[kMaxBands], float (&peak)[kMaxBands], int deg = kDeg,
+                                     bool clamp = true) {
   const float w = f.zonal_weight(point, to_eye);
   if (!(w > 0.0f)) return false;
   float sum[kMaxBands] = {}, frac[kMaxBands] = {}, own[kMaxBands] = {};
@@ -111,10 +112,36 @@ NEBULA_HD bool zonal_scattered_light(const Scene& s, const DiffuseView& f, float
   NEBULA_UNROLL
   for (int b = 0; b < kMaxBands; ++b)
     if (row[b]) {
-      light[b] = fmaxf(0.0f, own[b] + w * (sum[b] - own[b]));
+      light[b] = own[b] + w * (sum[b] - own[b]);
+      if (clamp) light[b] = fmaxf(0.0f, light[b]);
       peak[b] = f.peak(b, s.albedo[b] * tau_v * s.extinction_ratio[b], w);
     }
   return true;
+}
+
+// The light field cell `cell` sends towards the eye (unit to_eye) from the dust
+// at `point` (V-band depth tau_v) per band with a field, and its forward peak:
+// the harmonics' response, or with zonal degrees (kZonal) the zonal one where
+// its weight is above 0. clamp: never negative (a voxel's light: a truncated
+// series can dip below zero where the field is peaked); false: the linear
+// response itself (the near-star term's B, diffuse/near_star.h). The grid's
+// per-view pass and its marcher's near-star term call it (raycast/).
+template <int kDeg, bool kZonal, class Scene>
+NEBULA_HD void field_scattered_light(const Scene& s, const DiffuseView& f, float tau_v, size_t cell, Vec3 point,
+                                     Vec3 to_eye, float (&light)[kMaxBands], float (&peak)[kMaxBands],
+                                     bool clamp = true, int deg = kDeg) {
+  float D[kMaxBands][kDeg + 1];
+  f.project<kDeg>(cell, to_eye, D, deg);
+  if constexpr (kZonal) {
+    if (zonal_scattered_light<kDeg>(s, f, tau_v, cell, point, to_eye, D, light, peak, deg, clamp)) return;
+  }
+  NEBULA_UNROLL
+  for (int b = 0; b < kMaxBands; ++b)
+    if (b < s.n_bands && f.has[b]) {
+      // The own response's peak, as DiffuseView::peak gives it (w = 0).
+      const float v = f.scattered<kDeg>(b, s.albedo[b] * tau_v * s.extinction_ratio[b], D[b], &peak[b], deg);
+      light[b] = clamp ? fmaxf(0.0f, v) : v;
+    }
 }
 
 }  // namespace nebula

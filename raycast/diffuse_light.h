@@ -36,20 +36,8 @@ NEBULA_HD void voxel_diffuse_light(const MarchScene& s, const Camera& camera, in
   for (int b = 0; b < kMaxBands; ++b) light[b] = peak[b] = 0.0f;
   if (!(tau_v > 0.0f)) return;
   const Vec3 centre = g.origin + g.voxel * Vec3{x + 0.5f, y + 0.5f, z + 0.5f};
-  float D[kMaxBands][kDeg + 1];
-  const size_t cell = s.diffuse.cell_of(x, y, z);
-  const Vec3 to_eye = camera.to_eye(centre);
-  s.diffuse.project<kDeg>(cell, to_eye, D);
-  if constexpr (kZonal) {
-    if (zonal_scattered_light<kDeg>(s, s.diffuse, tau_v, cell, centre, to_eye, D, light, peak))
-      return;
-  }
-  NEBULA_UNROLL
-  for (int b = 0; b < kMaxBands; ++b)
-    if (b < s.n_bands && s.diffuse.has[b]) {
-      // The own response's peak, as DiffuseView::peak gives it (w = 0).
-      light[b] = fmaxf(0.0f, s.diffuse.scattered<kDeg>(b, s.albedo[b] * tau_v * s.extinction_ratio[b], D[b], &peak[b]));
-    }
+  field_scattered_light<kDeg, kZonal>(s, s.diffuse, tau_v, s.diffuse.cell_of(x, y, z), centre, camera.to_eye(centre),
+                                      light, peak);
 }
 
 // Where the light and its forward peak go: an array each per band with a

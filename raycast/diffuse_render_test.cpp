@@ -5,7 +5,9 @@
 #include <cmath>
 #include <utility>
 
+#include "core/placement.h"
 #include "diffuse/diffuse_bake.h"
+#include "raycast/march_scene.h"
 #include "raycast/renderer.h"
 #include "raycast/test_scenes.h"
 
@@ -98,6 +100,52 @@ TEST(DiffuseRender, ConservesEnergyAtAlbedoOne) {
     EXPECT_NEAR(with / expected, 1.0, allowed) << "g " << g << " zonal " << zonal;
     EXPECT_LT(without / expected, 1.0 - allowed) << "the test must tell the field from no field";
   }
+}
+
+// Near a star with zonal degrees the marcher evaluates the field on each
+// chord (ray_march.h, add_chord_field_light): at a voxel's centre, seen from
+// the per-view pass's eye, that is the per-view pass's light bit for bit (one
+// function), and off the centre near the star the light differs (the zonal
+// response turns with the direction from the star), so the near rays do use it.
+TEST(DiffuseRender, NearRaysTakeTheZonalFieldOnTheirChords) {
+  OneStarScene s;
+  s.grid = cube(16, 1.0f);
+  fill_sphere(s.grid, 0.8f, s.grid.shape.voxel / 0.8f);
+  s.table = thin_table(0.9f);
+  s.finish({0.03f, -0.02f, 0.01f}, 1000.0f, 0.9f, telescope(32, 2.0f));
+  s.inputs.bands[0].g = 0.9f;
+  const DiffuseField field = bake(s, 0.9f, 1u << 15, nullptr, 12);
+  s.inputs.diffuse = &field;
+  const DiffuseLightArrays planes = diffuse_light_arrays(s.inputs, Backend::Cpu);
+  HostPlacement host;
+  MarchScene scene = assemble_march_scene(s.inputs, host);
+  scene.diffuse_light[0] = planes.light[0].data();
+  scene.diffuse_peak[0] = planes.peak[0].data();
+  ASSERT_GT(scene.chord_field_radius, 0.0f);
+  const GridShape& g = s.grid.shape;
+  const Vec3 star = s.inputs.stars[0].position;
+  int compared = 0, moved = 0;
+  for (int z = 0; z < g.nz; ++z)
+    for (int y = 0; y < g.ny; ++y)
+      for (int x = 0; x < g.nx; ++x) {
+        const size_t voxel = g.index(x, y, z);
+        const Vec3 centre = g.centre(x, y, z);
+        const float tau_v = s.grid.tau_v[voxel];
+        if (!(tau_v > 0.0f) || !near_a_zonal_star(scene.diffuse, centre, scene.chord_field_radius)) continue;
+        float source[kMaxBands] = {}, peak[kMaxBands] = {};
+        add_chord_field_light(scene, x, y, z, centre, s.inputs.camera.to_eye(centre), tau_v, source, peak);
+        ASSERT_EQ(source[0], planes.light[0][voxel]) << x << " " << y << " " << z;
+        ASSERT_EQ(peak[0], planes.peak[0][voxel]) << x << " " << y << " " << z;
+        ++compared;
+        if (length(centre - star) < 3 * g.voxel) {
+          float off[kMaxBands] = {}, off_peak[kMaxBands] = {};
+          const Vec3 corner = centre + 0.45f * g.voxel * Vec3{1.0f, -1.0f, 1.0f};
+          add_chord_field_light(scene, x, y, z, corner, s.inputs.camera.to_eye(centre), tau_v, off, off_peak);
+          moved += std::fabs(off[0] - source[0]) > 1e-3f * std::fabs(source[0]);
+        }
+      }
+  EXPECT_GT(compared, 100);
+  EXPECT_GT(moved, 0) << "off the voxels' centres near the star the zonal response must turn";
 }
 
 // A star exactly at a voxel corner (and one inside a voxel), a tau = 1000

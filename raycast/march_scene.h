@@ -2,6 +2,7 @@
 // The ray marcher's kernel scene, assembled once from RenderInputs for both
 // backends (core/placement.h): the CPU path places the host arrays
 // themselves, the CUDA path uploads them. Host code only.
+#include <algorithm>
 #include <cmath>
 #include <utility>
 #include <vector>
@@ -67,6 +68,12 @@ MarchScene assemble_march_scene(const RenderInputs& in, Place& place) {
   if (in.diffuse) {
     scene.has_diffuse = true;
     scene.diffuse = place_diffuse(*in.diffuse, place);
+    scene.chord_field_radius = kChordFieldVoxels * in.density->shape.voxel;
+    // Every ray crossing a chord that takes the field on the chord is a near
+    // one (a table with few angle bins has a smaller phase radius), so the
+    // image has no seam where the near rays end.
+    if (scene.diffuse.zonal > 0)
+      scene.near_star_radius = std::max(scene.near_star_radius, scene.chord_field_radius);
   }
   return scene;
 }
