@@ -35,6 +35,8 @@ camera.exposure) and the same tone mapping as `nebula render -o X.png`
 so brightness and colour compare directly. Writes each image as HDF5 (the
 data, which compare reads) and PNG into --renders, and the montage into --out.
 --no-truth leaves the truth out (quick looks; the montage is the fast row).
+--truth-strata K (default 4) samples each truth pixel's area in K x K strata:
+the pixel's mean, which the fast renderer's pixels at a star stand for.
 --render-only runs the renders and truths and stops (no numpy, h5py or
 matplotlib needed: for a GPU machine without them); --reuse then makes the
 montage elsewhere from those files, rendering only what is missing or was
@@ -44,7 +46,7 @@ NAME.h5.args).
 Usage: /usr/bin/python3 validation/gallery.py [--study fig12|pyramid|axial|axial_deform|axial_ms]
            [--nebula build/bin/nebula] [--scene SCENE (default: the study's)]
            [--out docs/images] [--renders out/gallery] [--size 384]
-           [--truth-spp 256 | --no-truth] [--backend auto] [--render-only | --reuse]
+           [--truth-spp 256 [--truth-strata 4] | --no-truth] [--backend auto] [--render-only | --reuse]
 Needs numpy, h5py and matplotlib (Debian: python3-numpy, python3-h5py,
 python3-matplotlib).
 """
@@ -212,6 +214,10 @@ def main():
     parser.add_argument("--size", type=int, default=384, help="image width and height in pixels")
     parser.add_argument("--truth-spp", type=int, default=256,
                         help="samples per pixel of the truth (nebula truth --equiangular --spp)")
+    parser.add_argument("--truth-strata", type=int, default=4,
+                        help="the truth's pixel-area strata per side, the largest up to this whose square divides "
+                             "--truth-spp (the pixel's mean, as the fast renderer's star pixels take it; 1: the "
+                             "pixel's centre ray)")
     parser.add_argument("--no-truth", action="store_true", help="the fast images only (quick looks)")
     parser.add_argument("--backend", default="auto")
     parser.add_argument("--render-only", action="store_true",
@@ -238,6 +244,11 @@ def main():
         fail("--size: at least 16 pixels")
     if truth_mode and args.truth_spp < 2:
         fail("--truth-spp: at least 2 (the truth's variance needs two samples)")
+    if args.truth_strata < 1:
+        fail("--truth-strata: at least 1")
+    # The pixel's mean from k x k jittered strata (any k estimates the same mean), as accuracy_report.py takes it.
+    strata_side = max(j for j in range(1, args.truth_strata + 1) if args.truth_spp % (j * j) == 0)
+    strata = ["--set", f"render.samples_per_pixel={strata_side * strata_side}"] if strata_side > 1 else []
 
     if not args.render_only:
         import matplotlib
@@ -246,12 +257,13 @@ def main():
         import matplotlib.pyplot as plt
 
     size = ["--width", str(args.size), "--height", str(args.size)]
-    truth_label = f"truth (path tracer, {args.truth_spp} spp)"
+    truth_label = (f"truth (path tracer, {args.truth_spp} spp"
+                   + (f", {strata_side}x{strata_side} strata)" if strata_side > 1 else ")"))
 
     def render_truth(name, extra):
         h5 = os.path.join(args.renders, f"{args.study}_{name}.h5")
         render_file(args.nebula, ["truth", args.scene, "-o", h5, "--force", "-q", "--equiangular", "--spp",
-                                  str(args.truth_spp), "--backend", args.backend] + size + extra,
+                                  str(args.truth_spp), "--backend", args.backend] + size + strata + extra,
                     h5, f"the truth of {name}", args.reuse)
         png = os.path.splitext(h5)[0] + ".png"
         if not args.render_only:
