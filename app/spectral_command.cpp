@@ -135,7 +135,7 @@ void add_spectral_bench(CLI::App* bench) {
     int size = 64, width = 256, height = 256, repeats = 3, stars = 1, reference = 400;
     double near_voxels = spectral::SpectralSettings{}.near_voxels;
     float tau = 4.0f;
-    bool quick = false, diffuse = false;
+    bool quick = false, diffuse = false, no_star_pixels = false;
     std::vector<std::string> filters{"B", "V", "R"};
   };
   auto o = std::make_shared<Options>();
@@ -170,6 +170,9 @@ void add_spectral_bench(CLI::App* bench) {
   cmd->add_flag("--diffuse", o->diffuse,
                 "with --scene and --table: every row with the light between voxels (the scene's render.diffuse_* "
                 "settings), its field baked once and its per-view pass timed apart (docs/spectral.md)");
+  cmd->add_flag("--no-star-pixels", o->no_star_pixels,
+                "one ray per pixel at the stars' images too (render.star_pixels = false): the stars' own pixels "
+                "take thousands of rays per star (docs/marcher.md), a cost that grows with the stars");
   cmd->add_option("--json", o->json, "also write the results as JSON to this file");
   cmd->callback([o, width, height] {
     if (o->attenuation != "inverse" && o->attenuation != "law")
@@ -282,6 +285,7 @@ void add_spectral_bench(CLI::App* bench) {
       in.g = b.g;
       in.camera = b.camera;
       in.table = table ? &*table : nullptr;
+      in.star_pixels = !o->no_star_pixels;
       if (m.n_stars == S) in.diffuse = diffuse_light(m);
       for (size_t c = 0; c < b.emission.size(); ++c) {  // a grid (scale applied) or tau_V times the scale
         const bool grid = !b.emission_grids[c].empty();
@@ -296,10 +300,13 @@ void add_spectral_bench(CLI::App* bench) {
                 filter_list.c_str(), o->attenuation.c_str(),
                 table ? ("table " + o->table + " read at " + std::to_string(o->table_nodes) + " attenuations").c_str()
                       : "thin-voxel limit (no table)");
+    std::printf("the stars' own pixels: %s\n", o->no_star_pixels ? "one ray each (--no-star-pixels)"
+                                                                 : "many rays each (render.star_pixels)");
     if (!b.emission.empty())
       std::printf("emission: %zu component(s) from the scene's [[spectral.emission]], in every row\n", b.emission.size());
     std::string json = "{\n  \"scene\": " + json_string(b.name) + ",\n  \"emission_components\": " +
                        std::to_string(b.emission.size()) + ",\n  \"stars\": " + std::to_string(S) +
+                       ",\n  \"star_pixels\": " + (o->no_star_pixels ? "false" : "true") +
                        ",\n  \"width\": " + std::to_string(b.camera.width) + ",\n  \"height\": " +
                        std::to_string(b.camera.height) + ",\n  \"filters\": " + json_string(filter_list) +
                        ",\n  \"attenuation\": " + json_string(o->attenuation) + ",\n  \"table\": " +
