@@ -123,9 +123,9 @@ Image render_axial_cpu(const AxialRenderInputs& in, AxialRenderStats* stats) {
       // The pixels at each star's image, with many rays each (illumination/star_pixels.h).
       if (in.star_pixels)
       march_star_pixels_cpu(in.camera, star_positions(in.stars), scene.n_bands, in.exposure, image.pixels.data(),
-                            [&](Vec3 origin, Vec3 dir, int side, float* out, size_t stride) {
+                            [&](Vec3 origin, Vec3 dir, float narrowing, float* out, size_t stride) {
                               AxialMarchScene sub = scene;
-                              sub.footprint = sub_pixel_footprint(scene.footprint, side);
+                              sub.footprint = sub_pixel_footprint(scene.footprint, narrowing);
                               const RayResult r = march_axial_ray<decltype(mode)::value, true, decltype(field)::value,
                                                                   decltype(deform)::value>(sub, origin, dir);
                               for (int b = 0; b < scene.n_bands; ++b) out[size_t(b) * stride] = r.radiance[b];

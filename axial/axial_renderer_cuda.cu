@@ -14,7 +14,7 @@
 #include "core/cuda_timer.h"
 #include "core/device_array.h"
 #include "core/device_placement.h"
-#include "illumination/star_pixels.h"
+#include "illumination/star_pixels_cuda.h"
 
 namespace nebula {
 namespace {
@@ -41,8 +41,8 @@ __global__ void __launch_bounds__(256, NEBULA_AXIAL_MIN_BLOCKS)
   if (r.table_clamps) atomicAdd(clamps, static_cast<unsigned long long>(r.table_clamps));
 }
 
-// One thread per ray of the pixels at each star's image (raycast/star_pixels.h),
-// each standing for its sub-pixel, into sub; then averaged per pixel in order.
+// One thread per ray of the pixels at each star's image (illumination/star_pixels.h),
+// each standing for its sub-cell, into sub; then stored per pixel from its cells.
 template <AxialSkip kMode, AxialField kField, bool kDeform>
 __global__ void __launch_bounds__(256) axial_star_pixel_kernel(AxialMarchScene scene, Camera camera,
                                                                const StarPixel* list, int n, int rays, float* sub,
@@ -51,19 +51,13 @@ __global__ void __launch_bounds__(256) axial_star_pixel_kernel(AxialMarchScene s
   if (i >= rays) return;
   const RayFootprint pixel = scene.footprint;
   const int n_clamps = march_star_pixel_ray(camera, list, n, rays, i, kMaxBands, sub,
-                                            [&](Vec3 origin, Vec3 dir, int side, float* out, size_t stride) {
-    scene.footprint = sub_pixel_footprint(pixel, side);
+                                            [&](Vec3 origin, Vec3 dir, float narrowing, float* out, size_t stride) {
+    scene.footprint = sub_pixel_footprint(pixel, narrowing);
     const RayResult r = march_axial_ray<kMode, true, kField, kDeform>(scene, origin, dir);
     for (int b = 0; b < kMaxBands; ++b) out[size_t(b) * stride] = r.radiance[b];
     return r.table_clamps;
   });
   if (n_clamps) atomicAdd(clamps, static_cast<unsigned long long>(n_clamps));
-}
-
-__global__ void axial_star_pixel_store_kernel(const StarPixel* list, int n, const float* sub, int rays, int n_bands,
-                                              float exposure, float* pixels, int width, int height) {
-  const int i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i < n) store_star_pixel(sub, size_t(rays), list[i], n_bands, exposure, pixels, width, height);
 }
 
 thread_local SideStream star_pixel_stream;  // the star pixels' rays, beside the main launch
@@ -111,9 +105,8 @@ Image render_axial_cuda(const AxialRenderInputs& in, AxialRenderStats* stats) {
         <<<grid, block>>>(scene, in.camera, in.exposure, pixels.get(), clamps.get());
     if (!list.empty()) {
       star_pixel_stream.join();
-      axial_star_pixel_store_kernel<<<unsigned((list.size() + 127) / 128), 128>>>(
-          device_list->get(), int(list.size()), sub->get(), rays, scene.n_bands, in.exposure, pixels.get(),
-          in.camera.width, in.camera.height);
+      store_star_pixels_cuda(device_list->get(), int(list.size()), sub->get(), rays, scene.n_bands, in.exposure,
+                             pixels.get(), in.camera.width, in.camera.height);
     }
   });
   NEBULA_CUDA_CHECK(cudaGetLastError());

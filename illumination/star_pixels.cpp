@@ -4,6 +4,43 @@
 #include <cmath>
 
 namespace nebula {
+namespace {
+
+struct Point2 {
+  double x, y;
+};
+
+// Distance from point s to the square [u, u + size] x [v, v + size].
+double distance_to_cell(Point2 s, double u, double v, double size) {
+  const double dx = std::max({u - s.x, 0.0, s.x - (u + size)});
+  const double dy = std::max({v - s.y, 0.0, s.y - (v + size)});
+  return std::sqrt(dx * dx + dy * dy);
+}
+
+// The cells of one pixel (stars: the stars' images in its own coordinates,
+// the pixel being [0, 1]^2), depth first, the four children in row order.
+void add_cells(const std::vector<Point2>& stars, double u, double v, double size, StarPixel pixel,
+               std::vector<StarPixel>& out, int& rays) {
+  double d = INFINITY;
+  for (const Point2& s : stars) d = std::min(d, distance_to_cell(s, u, v, size));
+  if (d < kStarCellSplit * size && size > 1.5 * kStarCellFinest) {
+    const double h = 0.5 * size;
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) add_cells(stars, u + i * h, v + j * h, h, pixel, out, rays);
+    return;
+  }
+  pixel.u = float(u);
+  pixel.v = float(v);
+  pixel.size = float(size);
+  const double k = size >= 1.0 ? kStarPixelRays : kStarCellRays;
+  pixel.side = size < 1.5 * kStarCellFinest ? kStarFinestCellSide : int(std::ceil(k / (1.0 + d / size) - 1e-9));
+  pixel.first = rays;
+  pixel.cells = 0;
+  rays += pixel.side * pixel.side;
+  out.push_back(pixel);
+}
+
+}  // namespace
 
 std::vector<Vec3> star_positions(const std::vector<BakedStar>& stars) {
   std::vector<Vec3> out;
@@ -12,8 +49,8 @@ std::vector<Vec3> star_positions(const std::vector<BakedStar>& stars) {
 }
 
 std::vector<StarPixel> star_pixels(const Camera& camera, const std::vector<Vec3>& stars, int* rays) {
-  // Per pixel the finest side any star asks for (0: none).
-  std::vector<std::pair<int, int>> wanted;  // (pixel index, side)
+  // Per pixel, the images of the stars that reach it.
+  std::vector<std::pair<int, Point2>> wanted;  // (pixel index, star image in image coordinates)
   for (const Vec3& star : stars) {
     const std::optional<ImagePoint> at = project_point(camera, star);
     if (!at) continue;
@@ -25,26 +62,25 @@ std::vector<StarPixel> star_pixels(const Camera& camera, const std::vector<Vec3>
       for (int x = x0; x <= x1; ++x) {
         Vec3 o, d;
         if (!camera.ray(x, y, o, d)) continue;  // a fisheye pixel outside the dome
-        const double reach = std::max(std::fabs(x + 0.5 - at->x), std::fabs(y + 0.5 - at->y));
-        wanted.push_back({y * camera.width + x, reach <= kStarPixelCore ? kStarPixelCoreSide : kStarPixelSide});
+        wanted.push_back({y * camera.width + x, Point2{at->x, at->y}});
       }
   }
-  std::sort(wanted.begin(), wanted.end());
+  std::stable_sort(wanted.begin(), wanted.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<StarPixel> out;
   int total = 0;
-  for (size_t i = 0; i < wanted.size(); ++i) {
-    const bool last_of_pixel = i + 1 == wanted.size() || wanted[i + 1].first != wanted[i].first;
-    if (!last_of_pixel) {
-      wanted[i + 1].second = std::max(wanted[i + 1].second, wanted[i].second);
-      continue;
-    }
+  for (size_t i = 0; i < wanted.size();) {
+    size_t end = i;
     StarPixel p;
     p.x = wanted[i].first % camera.width;
     p.y = wanted[i].first / camera.width;
-    p.side = wanted[i].second;
-    p.first = total;
-    total += p.side * p.side;
-    out.push_back(p);
+    std::vector<Point2> local;
+    for (; end < wanted.size() && wanted[end].first == wanted[i].first; ++end)
+      local.push_back({wanted[end].second.x - p.x, wanted[end].second.y - p.y});
+    const size_t start = out.size();
+    add_cells(local, 0.0, 0.0, 1.0, p, out, total);
+    out[start].cells = int(out.size() - start);
+    i = end;
   }
   if (rays) *rays = total;
   return out;

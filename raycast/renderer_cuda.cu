@@ -16,7 +16,7 @@
 #include "raycast/host_copy.h"
 #include "raycast/march_scene.h"
 #include "raycast/renderer.h"
-#include "illumination/star_pixels.h"
+#include "illumination/star_pixels_cuda.h"
 #include "raycast/voxel_sources.h"
 
 namespace nebula {
@@ -95,8 +95,8 @@ __global__ void __launch_bounds__(256, kSmooth ? 2 : NEBULA_RENDER_MIN_BLOCKS)
 }
 
 // One thread per ray of the pixels at each star's image (illumination/star_pixels.h),
-// each ray standing for its sub-pixel, into sub (kMaxBands per ray); the
-// store kernel then averages each pixel's rays in their order. Launched on
+// each ray standing for its sub-cell, into sub (kMaxBands per ray); the
+// store (illumination/star_pixels_cuda.h) then sums each pixel's cells. Launched on
 // the near rays' side stream, beside the main launch.
 template <bool kDiffuse, bool kZonal>
 __global__ void __launch_bounds__(256) star_pixel_kernel(MarchScene scene, Camera camera, MarchMode mode,
@@ -106,19 +106,13 @@ __global__ void __launch_bounds__(256) star_pixel_kernel(MarchScene scene, Camer
   if (i >= rays) return;
   const RayFootprint pixel = scene.footprint;
   const int n_clamps = march_star_pixel_ray(camera, list, n, rays, i, kMaxBands, sub,
-                                            [&](Vec3 origin, Vec3 dir, int side, float* out, size_t stride) {
-    scene.footprint = sub_pixel_footprint(pixel, side);
+                                            [&](Vec3 origin, Vec3 dir, float narrowing, float* out, size_t stride) {
+    scene.footprint = sub_pixel_footprint(pixel, narrowing);
     const RayResult r = march_ray<false, kDiffuse, false, kZonal, true>(scene, origin, dir, mode);
     for (int b = 0; b < kMaxBands; ++b) out[size_t(b) * stride] = r.radiance[b];
     return r.table_clamps;
   });
   if (n_clamps) atomicAdd(clamps, static_cast<unsigned long long>(n_clamps));
-}
-
-__global__ void star_pixel_store_kernel(const StarPixel* list, int n, const float* sub, int rays, int n_bands,
-                                        float exposure, float* pixels, int width, int height) {
-  const int i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i < n) store_star_pixel(sub, size_t(rays), list[i], n_bands, exposure, pixels, width, height);
 }
 
 // A device array kept per thread and reused while the size asked for fits:
@@ -246,9 +240,8 @@ double render_cuda_to_device(const RenderInputs& in, float* pixels, unsigned lon
         // After every launch: the star pixels replace their single rays.
         if (!star_list.empty()) {
           star_side.join();
-          star_pixel_store_kernel<<<unsigned((star_list.size() + 127) / 128), 128>>>(
-              device_list, int(star_list.size()), star_sub, star_rays, scene.n_bands, in.exposure, pixels,
-              in.camera.width, in.camera.height);
+          store_star_pixels_cuda(device_list, int(star_list.size()), star_sub, star_rays, scene.n_bands, in.exposure,
+                                 pixels, in.camera.width, in.camera.height);
         }
         return;
       }

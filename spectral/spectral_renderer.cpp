@@ -222,9 +222,9 @@ Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds) {
       for (const SpectralLight& l : in.lights) positions.push_back(l.position);
     std::atomic<uint64_t> no_clamps{0};  // the spectral marcher counts none
     march_star_pixels_cpu(in.camera, positions, m.planes(), 1.0f, image.pixels.data(),
-                          [&](Vec3 origin, Vec3 dir, int side, float* out, size_t stride) {
+                          [&](Vec3 origin, Vec3 dir, float narrowing, float* out, size_t stride) {
                             SpectralSceneView sub = view;
-                            sub.footprint = sub_pixel_footprint(view.footprint, side);
+                            sub.footprint = sub_pixel_footprint(view.footprint, narrowing);
                             DynamicAccumulators acc;
                             float em[kMaxEmissionPlanes];
                             march_spectral<method(), true>(sub, origin, dir, acc, em);

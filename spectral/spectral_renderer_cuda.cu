@@ -11,7 +11,7 @@
 #include "core/cuda_side_stream.h"
 #include "core/cuda_timer.h"
 #include "core/device_array.h"
-#include "illumination/star_pixels.h"
+#include "illumination/star_pixels_cuda.h"
 #include "spectral/spectral_renderer.h"
 
 namespace nebula::spectral {
@@ -41,7 +41,7 @@ __global__ void spectral_kernel(SpectralSceneView scene, Camera camera, float* p
 }
 
 // One thread per ray of the pixels at each star's image (illumination/star_pixels.h),
-// each standing for its sub-pixel, into sub (plane k of ray i at sub[k * rays + i]).
+// each standing for its sub-cell, into sub (plane k of ray i at sub[k * rays + i]).
 template <SpectralMethod kMethod, class Acc>
 __global__ void spectral_star_pixel_kernel(SpectralSceneView scene, Camera camera, const StarPixel* list, int n,
                                            int rays, int n_planes, float* sub) {
@@ -49,8 +49,8 @@ __global__ void spectral_star_pixel_kernel(SpectralSceneView scene, Camera camer
   if (i >= rays) return;
   const RayFootprint pixel = scene.footprint;
   march_star_pixel_ray(camera, list, n, rays, i, n_planes, sub,
-                       [&](Vec3 origin, Vec3 dir, int side, float* out, size_t stride) {
-    scene.footprint = sub_pixel_footprint(pixel, side);
+                       [&](Vec3 origin, Vec3 dir, float narrowing, float* out, size_t stride) {
+    scene.footprint = sub_pixel_footprint(pixel, narrowing);
     Acc acc;
     float em[kMaxEmissionPlanes];
     march_spectral<kMethod, true>(scene, origin, dir, acc, em);
@@ -58,12 +58,6 @@ __global__ void spectral_star_pixel_kernel(SpectralSceneView scene, Camera camer
     store_emission(scene, em, out, stride);
     return 0;
   });
-}
-
-__global__ void spectral_star_pixel_store_kernel(const StarPixel* list, int n, const float* sub, int rays,
-                                                 int n_planes, float* pixels, int width, int height) {
-  const int i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i < n) store_star_pixel(sub, size_t(rays), list[i], n_planes, 1.0f, pixels, width, height);
 }
 
 // VoxelLight's per-view pre-pass: one voxel per thread (spectral_march.h);
@@ -278,9 +272,8 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
         near_rays.join();
         if (!list.empty()) star_pixel_rays.join();
         if (!list.empty())  // after every launch: the star pixels replace their single rays
-          spectral_star_pixel_store_kernel<<<unsigned((list.size() + 127) / 128), 128>>>(
-              device_list.get(), int(list.size()), sub.get(), rays, m.planes(), pixels.get(), in.camera.width,
-              in.camera.height);
+          store_star_pixels_cuda(device_list.get(), int(list.size()), sub.get(), rays, m.planes(), 1.0f, pixels.get(),
+                                 in.camera.width, in.camera.height);
       } else {
         spectral_kernel<method(), decltype(acc), false><<<grid, block>>>(view, in.camera, pixels.get());
       }
