@@ -198,12 +198,17 @@ void print_report(const RunReport& r) {
                 t.counters.vertices / s, t.paths / s, t.spp / s, r.total_seconds);
     return;
   }
+  char star_pixels[160] = "";
+  if (r.star_pixel_rays > 0)
+    std::snprintf(star_pixels, sizeof star_pixels,
+                  " (the %d pixels at the stars' images in %d cells, %d rays: render.star_pixels)", r.star_pixels,
+                  r.star_pixel_cells, r.star_pixel_rays);
   if (r.spectral) {
-    std::printf("render: %.3f s marching; total %.2f s\n", r.render_seconds, r.total_seconds);
+    std::printf("render: %.3f s marching%s; total %.2f s\n", r.render_seconds, star_pixels, r.total_seconds);
     return;
   }
-  std::printf("render: %.3f s marching, %llu table lookups beyond tau_max (clamped); total %.2f s\n", r.render_seconds,
-              (unsigned long long)r.table_clamps, r.total_seconds);
+  std::printf("render: %.3f s marching%s, %llu table lookups beyond tau_max (clamped); total %.2f s\n",
+              r.render_seconds, star_pixels, (unsigned long long)r.table_clamps, r.total_seconds);
 }
 
 }  // namespace nebula::app

@@ -86,4 +86,12 @@ std::vector<StarPixel> star_pixels(const Camera& camera, const std::vector<Vec3>
   return out;
 }
 
+StarPixelCount count_star_pixels(const Camera& camera, const std::vector<Vec3>& stars) {
+  StarPixelCount n;
+  const std::vector<StarPixel> cells = star_pixels(camera, stars, &n.rays);
+  n.cells = int(cells.size());
+  for (const StarPixel& c : cells) n.pixels += c.cells > 0;
+  return n;
+}
+
 }  // namespace nebula

@@ -56,6 +56,12 @@ std::vector<Vec3> star_positions(const std::vector<BakedStar>& stars);
 // consecutively; `rays` gets their total.
 std::vector<StarPixel> star_pixels(const Camera& camera, const std::vector<Vec3>& stars, int* rays);
 
+// How many star pixels, cells and rays star_pixels gives (for run reports).
+struct StarPixelCount {
+  int pixels = 0, cells = 0, rays = 0;
+};
+StarPixelCount count_star_pixels(const Camera& camera, const std::vector<Vec3>& stars);
+
 // Ray k (0 <= k < side^2) of a cell: the centre of its stratum.
 NEBULA_HD bool star_pixel_ray(const Camera& c, const StarPixel& p, int k, Vec3& origin, Vec3& dir) {
   const float step = p.size / float(p.side);

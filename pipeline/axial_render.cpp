@@ -9,6 +9,7 @@
 #include "axial/axial_renderer.h"
 #include "core/error.h"
 #include "core/progress.h"
+#include "illumination/star_pixels.h"
 #include "pipeline/axial_map_source.h"
 #include "pipeline/render_scene.h"
 #include "pipeline/run_setup.h"
@@ -140,6 +141,9 @@ RenderOutput render_axial_scene(const Scene& scene, const RenderOptions& o) {
   report.axial = map_report;
   report.render_seconds = stats.seconds;
   report.table_clamps = stats.table_clamps;
+  if (in.star_pixels && !in.stars.empty()) {
+    report_star_pixels(in.camera, star_positions(in.stars), report);
+  }
   out.metadata = scene_metadata(scene, sb, scene.camera, report.mode);
   out.metadata.entries.push_back({"multiple_scattering", multiple_scattering_text(report)});
   out.metadata.entries.push_back({"pixel_samples", scene.samples_per_pixel});

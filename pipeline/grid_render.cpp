@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "core/progress.h"
 #include "diffuse/diffuse_bake.h"
+#include "illumination/star_pixels.h"
 #include "multires/volume_pyramid.h"
 #include "pipeline/render_scene.h"
 #include "pipeline/run_setup.h"
@@ -247,6 +248,10 @@ RenderOutput render_prepared(const PreparedGrid& p, const CameraSettings& settin
   for (const PyramidLevelReport& r : pyramid.report) {
     out.report.render_seconds += r.render_seconds;
     out.report.table_clamps += r.table_clamps;
+  }
+  // As the renderers decide (raycast/renderer.cpp): the exact traversal only.
+  if (in.star_pixels && in.mode.step_voxels == 0.0f && !preview && !in.stars.empty()) {
+    report_star_pixels(in.camera, star_positions(in.stars), out.report);
   }
   draw_scene_stars(scene, p.bands, camera, 1.0, out.image);
   out.metadata = scene_metadata(scene, p.bands, settings, p.report.mode);

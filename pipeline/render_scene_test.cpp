@@ -365,6 +365,24 @@ TEST_F(RenderScene, ErrorsNameTheKeyOrTheField) {
   }
 }
 
+// The report counts the pixels at the star's image that the exact traversal
+// marched with many rays each: the star sits at the image's centre (20 x 16
+// pixels, on four pixels' corner), so 6 x 6 pixels, the four at it cut into
+// cells; none when they are off or in the smooth mode.
+TEST_F(RenderScene, StarPixelsAreReported) {
+  RenderOutput out = render_scene(scene(), options());
+  EXPECT_EQ(out.report.star_pixels, 36);
+  EXPECT_GT(out.report.star_pixel_cells, 36);
+  EXPECT_GT(out.report.star_pixel_rays, 36 * 16);
+  out = render_scene(scene("[render]\nstar_pixels = false\n"), options());
+  EXPECT_EQ(out.report.star_pixels, 0);
+  EXPECT_EQ(out.report.star_pixel_rays, 0);
+  RenderOptions smooth = options();
+  smooth.smooth_step = 0.5;
+  out = render_scene(scene(), smooth);
+  EXPECT_EQ(out.report.star_pixel_rays, 0);
+}
+
 TEST_F(RenderScene, PyramidLevelsAreReported) {
   const Scene s = scene("[render]\nlevels = 2\n");
   EXPECT_EQ(s.multiple_scattering, MultipleScattering::Pyramid);  // levels ask for the pyramid

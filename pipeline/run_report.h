@@ -142,6 +142,9 @@ struct RunReport {
   std::optional<SpectralReport> spectral;
   double render_seconds = 0;  // marching or tracing only (CUDA events on the GPU)
   uint64_t table_clamps = 0;  // table lookups beyond tau_max (clamped)
+  // The pixels at the stars' images marched with many rays each
+  // (render.star_pixels; illumination/star_pixels.h): 0 when off or none.
+  int star_pixels = 0, star_pixel_cells = 0, star_pixel_rays = 0;
   double total_seconds = 0;
 };
 

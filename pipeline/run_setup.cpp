@@ -6,6 +6,7 @@
 #include "core/error.h"
 #include "illumination/passband.h"
 #include "core/progress.h"
+#include "illumination/star_pixels.h"
 #include "pipeline/render_scene.h"
 #include "raycast/point_stars.h"
 
@@ -156,6 +157,13 @@ void draw_scene_stars(const Scene& scene, const SceneBands& bands, const Camera&
   for (const Band& b : bands.bands) ratios.push_back(b.extinction_ratio);
   draw_point_stars(scene.density, bands.stars, ratios, camera, static_cast<float>(exposure), scene.star_psf_pixels,
                    image);
+}
+
+void report_star_pixels(const Camera& camera, const std::vector<Vec3>& stars, RunReport& report) {
+  const StarPixelCount n = count_star_pixels(camera, stars);
+  report.star_pixels = n.pixels;
+  report.star_pixel_cells = n.cells;
+  report.star_pixel_rays = n.rays;
 }
 
 CameraSettings supersampled_camera(const CameraSettings& camera, int samples_per_pixel) {

@@ -72,6 +72,10 @@ DiffuseReport diffuse_report(const std::vector<DiffuseBand>& bands, const Diffus
 // What an image's light between voxels (or cells) came from, for its metadata.
 std::string multiple_scattering_text(const RunReport& r);
 
+// The report's count of the star pixels a frame of `camera` marches with
+// many rays each around stars at these positions (illumination/star_pixels.h).
+void report_star_pixels(const Camera& camera, const std::vector<Vec3>& stars, RunReport& report);
+
 // Pixel-area sampling for the fast renderers (render.samples_per_pixel =
 // k^2): they trace the frame at k times the resolution, a k x k grid of
 // sub-pixel rays at the centres of equal strata, and each pixel is the mean

@@ -264,6 +264,11 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
   out.image = spectral::resolve_filters(acc, model);
   sr.resolve_seconds = seconds_since(t_resolve);
   report.render_seconds = march_seconds;
+  if (in.star_pixels && !in.lights.empty()) {
+    std::vector<Vec3> at;
+    for (const spectral::SpectralLight& l : in.lights) at.push_back(l.position);
+    report_star_pixels(in.camera, at, report);
+  }
   report.spectral = sr;
   draw_scene_stars(scene, bands, in.camera, 1.0, out.image);
 

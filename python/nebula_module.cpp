@@ -116,6 +116,8 @@ py::dict report_dict(const RunReport& r) {
   d["diffuse_reused"] = r.diffuse.reused;
   d["diffuse_shared_with"] = r.diffuse.shared_with;
   d["render_seconds"] = r.render_seconds;
+  d["star_pixels"] = r.star_pixels;  // the pixels at the stars' images (render.star_pixels)
+  d["star_pixel_rays"] = r.star_pixel_rays;
   d["total_seconds"] = r.total_seconds;
   return d;
 }
