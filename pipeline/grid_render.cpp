@@ -249,8 +249,7 @@ RenderOutput render_prepared(const PreparedGrid& p, const CameraSettings& settin
     out.report.render_seconds += r.render_seconds;
     out.report.table_clamps += r.table_clamps;
   }
-  // As the renderers decide (raycast/renderer.cpp): the exact traversal only.
-  if (in.star_pixels && in.mode.step_voxels == 0.0f && !preview && !in.stars.empty()) {
+  if (marches_star_pixels(in)) {
     report_star_pixels(in.camera, star_positions(in.stars), out.report);
   }
   draw_scene_stars(scene, p.bands, camera, 1.0, out.image);

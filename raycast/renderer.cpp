@@ -148,8 +148,8 @@ Image render_cpu(const RenderInputs& in, RenderStats* stats) {
     });
     if constexpr (exact) {
       // The pixels at each star's image, with many rays each (illumination/star_pixels.h).
-      if (in.star_pixels)
-      march_star_pixels_cpu(in.camera, star_positions(in.stars), scene.n_bands, in.exposure, image.pixels.data(),
+      if (marches_star_pixels(in))
+        march_star_pixels_cpu(in.camera, star_positions(in.stars), scene.n_bands, in.exposure, image.pixels.data(),
                             [&](Vec3 origin, Vec3 dir, float narrowing, float* out, size_t stride) {
                               MarchScene sub = scene;
                               sub.footprint = sub_pixel_footprint(scene.footprint, narrowing);

@@ -46,6 +46,14 @@ struct RenderStats {
   uint64_t table_clamps = 0; // lookups beyond the table's tau range
 };
 
+// Whether a frame of `in` marches the pixels at its stars' images with many
+// rays each: asked for, stars present, and the exact traversal (not the smooth
+// mode or the preview), as dispatch_march chooses. The CPU and CUDA renderers
+// and the run report all ask this.
+inline bool marches_star_pixels(const RenderInputs& in) {
+  return in.star_pixels && !in.stars.empty() && !in.mode.voxel_sources && !(in.mode.step_voxels > 0.0f);
+}
+
 // Throws Error on inconsistent inputs (missing table, sizes that disagree).
 Image render(const RenderInputs& in, Backend backend, RenderStats* stats = nullptr);
 Image render_cpu(const RenderInputs& in, RenderStats* stats);

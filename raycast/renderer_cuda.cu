@@ -169,8 +169,7 @@ double render_cuda_to_device(const RenderInputs& in, float* pixels, unsigned lon
   // The star pixels' list, on the device before the frame's first launch: a copy after
   // it would hold the host until the per-view pass ends, and the march's launches with it.
   int star_rays = 0;
-  const bool exact_march = !in.mode.voxel_sources && !(in.mode.step_voxels > 0.0f);  // dispatch_march's choice
-  const std::vector<StarPixel> star_list = in.star_pixels && scene.n_stars > 0 && exact_march
+  const std::vector<StarPixel> star_list = marches_star_pixels(in)
                                                ? star_pixels(in.camera, star_positions(in.stars), &star_rays)
                                                : std::vector<StarPixel>{};
   StarPixel* device_list = nullptr;
