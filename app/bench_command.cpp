@@ -145,6 +145,7 @@ void add_diffuse(CLI::App* bench) {
   struct Options : Common {
     int size = 256, width = 1920, height = 1080, degree = -1, cells = 64, zonal = 0;  // degree -1: as "auto"
     std::string photons = "1048576";
+    bool no_star_pixels = false;
   };
   auto o = std::make_shared<Options>();
   CLI::App* cmd = add_bench(bench, "diffuse",
@@ -158,6 +159,8 @@ void add_diffuse(CLI::App* bench) {
   cmd->add_option("--zonal", o->zonal, "zonal degrees of the star's light (0: none)")->capture_default_str()->check(CLI::Range(0, kMaxZonalDegree));
   cmd->add_option("--cells", o->cells, "field cells along the grid's edge (at least)")->capture_default_str()->check(CLI::Range(1, 4096));
   cmd->add_option("--photons", o->photons, "photons per band")->capture_default_str();
+  cmd->add_flag("--no-star-pixels", o->no_star_pixels,
+                "one ray per pixel at the star's image too (render.star_pixels = false): what the star's own pixels cost");
   cmd->callback([o] {
     const uint64_t photons = parse_count("--photons", o->photons, 1, 4294967295.0);
     if (o->degree < 0) o->degree = o->zonal > 0 ? 3 : 4;  // scene/scene.cpp, resolved_order
@@ -168,7 +171,8 @@ void add_diffuse(CLI::App* bench) {
       // The CPU renders a 1/10 x 1/10 image (same rays per second, minutes less).
       const bool cpu = backend == Backend::Cpu;
       const int w = cpu ? std::max(1, o->width / 10) : o->width, h = cpu ? std::max(1, o->height / 10) : o->height;
-      const DiffuseBench b = bench_diffuse(backend, o->size, w, h, cpu ? 1 : o->repeats, o->degree, o->cells, photons, o->zonal);
+      const DiffuseBench b = bench_diffuse(backend, o->size, w, h, cpu ? 1 : o->repeats, o->degree, o->cells, photons, o->zonal,
+                                           !o->no_star_pixels);
       std::printf("| %s | %d^3 | %d^3 | %d | %llu | %.2f | %.2f | %.2f | %.3f (%dx%d) | %.3f | %.1f | %.1f | %.1f | %.2g%% |\n",
                   b.backend.c_str(), b.size, b.cells, b.degree, (unsigned long long)b.photons, 1e3 * b.star_bake_seconds,
                   1e3 * b.photon_seconds, 1e3 * b.bake_wall_seconds, 1e3 * b.frame_without, b.width, b.height,
@@ -359,7 +363,7 @@ void add_axial(CLI::App* bench) {
     std::vector<int> inclinations{0, 15, 30, 45, 60, 75, 90};
     int map_size = 1024, image = 2048;
     float step = 0.5f;
-    bool emission_only = false, step_aside = true, diffuse = false;
+    bool emission_only = false, step_aside = true, diffuse = false, no_star_pixels = false;
     std::string deform = "both", noise = "fbm", write_maps;
   };
   auto o = std::make_shared<Options>();
@@ -389,6 +393,8 @@ void add_axial(CLI::App* bench) {
       ->capture_default_str()->check(CLI::IsMember({"off", "on", "both", "colour", "shape"}));
   cmd->add_option("--noise", o->noise, "the deformations' noise: simplex, fbm, turbulence or cellular")
       ->capture_default_str()->check(CLI::IsMember({"simplex", "fbm", "turbulence", "cellular"}));
+  cmd->add_flag("--no-star-pixels", o->no_star_pixels,
+                "with the star, one ray per pixel at its image too (render.star_pixels = false): what its own pixels cost");
   cmd->add_option("--write-maps", o->write_maps,
                   "write each map as FOLDER/<map>.h5 first (bands tau_v, B, V, R; the bottom row is the axis: "
                   "what [axial] image = ... reads back)");
@@ -448,7 +454,7 @@ void add_axial(CLI::App* bench) {
                     std::fflush(stdout);
                     rows.push_back(r);
                   },
-                  o->step_aside, modes, o->diffuse, deforms);
+                  o->step_aside, modes, o->diffuse, deforms, !o->no_star_pixels);
       std::vector<AxialSkip> shown = modes.empty() ? axial_skip_modes() : modes;
       shown.erase(std::remove(shown.begin(), shown.end(), AxialSkip::Naive), shown.end());
       shown.insert(shown.begin(), AxialSkip::Naive);

@@ -193,7 +193,7 @@ std::vector<RenderBenchRow> bench_render(Backend backend, int size, int width, i
 }
 
 DiffuseBench bench_diffuse(Backend backend, int size, int width, int height, int repeats, int degree, int cells,
-                           uint64_t photons, int zonal) {
+                           uint64_t photons, int zonal, bool star_pixels) {
   const BenchNebula nebula(backend, size, width, height);
   const std::vector<Vec3> positions{nebula.star(0)};
   DiffuseBench out;
@@ -204,7 +204,8 @@ DiffuseBench bench_diffuse(Backend backend, int size, int width, int height, int
   out.degree = degree;
   out.photons = photons;
   BakeResult bake = bake_star_depths(nebula.grid, positions, backend);  // warm-up
-  const RenderInputs in = nebula.inputs(positions, bake);
+  RenderInputs in = nebula.inputs(positions, bake);
+  in.star_pixels = star_pixels;
   std::vector<DiffuseBand> bands;
   for (const RenderBand& b : in.bands) {
     DiffuseBand d;
@@ -318,7 +319,8 @@ TruthBenchRow bench_truth(Backend backend, int size, int width, int height, int 
 void bench_axial(Backend backend, int map_size, int width, int height, int repeats, float step_texels,
                  const std::vector<std::string>& maps, const std::vector<int>& inclinations, bool star,
                  const std::function<void(const AxialBenchRow&)>& on_row, bool step_aside,
-                 std::vector<AxialSkip> modes, bool diffuse, const std::vector<AxialDeformSettings>& deforms) {
+                 std::vector<AxialSkip> modes, bool diffuse, const std::vector<AxialDeformSettings>& deforms,
+                 bool star_pixels) {
   if (modes.empty()) modes = axial_skip_modes();
   modes.erase(std::remove(modes.begin(), modes.end(), AxialSkip::Naive), modes.end());
   modes.insert(modes.begin(), AxialSkip::Naive);
@@ -338,6 +340,7 @@ void bench_axial(Backend backend, int map_size, int width, int height, int repea
     std::vector<std::vector<float>> depth;
     AxialRenderInputs in;
     in.map = &map;
+    in.star_pixels = star_pixels;
     const float ratios[3] = {1.2f, 1.0f, 0.85f};
     for (int b = 0; b < 3; ++b)
       in.bands.push_back(AxialRenderBand{{std::string(1, "BVR"[b]), ratios[b], star ? 0.6f : 0.0f}, star ? &table : nullptr});

@@ -70,7 +70,8 @@ std::vector<RenderBenchRow> bench_render(Backend backend, int size, int width, i
 // The diffuse field on the same nebula with one star (bands B, V, R, a = g =
 // 0.6): the bake after a change of the dust or the star (the star's depth bake
 // and the photon passes, medians of `repeats`), and frames without and with
-// the field (medians), with the field's memory and noise.
+// the field (medians), with the field's memory and noise. star_pixels false:
+// one ray per pixel at the star's image too (what the star's own pixels cost).
 struct DiffuseBench {
   std::string backend;
   int size = 0, width = 0, height = 0, degree = 0, cells = 0;
@@ -83,7 +84,7 @@ struct DiffuseBench {
   double noise = 0;  // relative L2 noise of the V band's l = 0 part
 };
 DiffuseBench bench_diffuse(Backend backend, int size, int width, int height, int repeats, int degree, int cells,
-                           uint64_t photons, int zonal = 0);
+                           uint64_t photons, int zonal = 0, bool star_pixels = true);
 
 // The cost of each pyramid level on the same nebula with one star: the
 // one-time build and bake per level, and per frame the median render time of
@@ -152,12 +153,14 @@ struct AxialBenchRow {
 // measure its overhead there). `diffuse` (with a star) adds the map's diffuse
 // field (axial/axial_diffuse.h: degree 3, 64 cells, 2^20 photons per band),
 // baked once per map. Each of `deforms` (default: none) runs every mode again,
-// the naive march under the same deformations as its reference.
+// the naive march under the same deformations as its reference. star_pixels
+// false: one ray per pixel at the star's image too.
 void bench_axial(Backend backend, int map_size, int width, int height, int repeats, float step_texels,
                  const std::vector<std::string>& maps, const std::vector<int>& inclinations, bool star,
                  const std::function<void(const AxialBenchRow&)>& on_row, bool step_aside = true,
                  std::vector<AxialSkip> modes = {}, bool diffuse = false,
-                 const std::vector<AxialDeformSettings>& deforms = {AxialDeformSettings{}});
+                 const std::vector<AxialDeformSettings>& deforms = {AxialDeformSettings{}},
+                 bool star_pixels = true);
 
 // The deformations `nebula bench axial` times (the thesis' "with deformations"
 // columns do not state theirs): colour and shape noise of `kind`, colour
