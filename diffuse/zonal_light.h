@@ -24,6 +24,59 @@ NEBULA_HD Pair load_pair(const float* p) {
 #endif
 }
 
+// Adds one zonal star's degrees deg + 1..f.zonal to both rows' sums of every
+// band with a field (at[b] >= 0): w y_l(mu) Z_l r_l, with Y_l0 = sqrt((2l + 1)
+// / (4 pi)) P_l(mu), mu the cosine between the eye and the direction from the
+// star to the dust (r), z the star's zonal sums Z_l in the cell.
+template <int kDeg>
+NEBULA_HD void add_zonal_star(const DiffuseView& f, const float* z, Vec3 r, Vec3 to_eye, float w, int deg,
+                              const int (&at)[kMaxBands], float (&s0)[kMaxBands], float (&s1)[kMaxBands]) {
+  const float len = length(r);
+  const float mu = len > 0.0f ? dot(to_eye, r) / len : to_eye.z;
+  float p_prev = 1.0f, p_l = mu;  // P_0 and P_1, then P_{l-1} and P_l
+  NEBULA_UNROLL
+  for (int l = 1; l < kDeg; ++l) {
+    if (l >= deg) break;
+    const float next = ((2.0f * l + 1.0f) * mu * p_l - float(l) * p_prev) / float(l + 1);
+    p_prev = p_l;
+    p_l = next;
+  }
+  if (deg == 0) p_l = 1.0f, p_prev = 0.0f;  // P_0 and "P_-1" (its weight is 0 below)
+  // Two degrees at a time: one 8-byte load per row and band serves both
+  // (rows of neighbouring voxels differ, so each scalar load is a gather);
+  // unrolled, so that every degree's constants are known at compile time.
+  NEBULA_UNROLL
+  for (int pair = 0; pair < kMaxZonalDegree / 2 + 1; ++pair) {
+    if (2 * pair + 1 <= deg) continue;  // both degrees within the harmonics
+    if (2 * pair > f.zonal) break;
+    Quad d[2];  // w y_l Z_l per band, l = 2 pair + j (0 outside deg < l <= zonal)
+    NEBULA_UNROLL
+    for (int j = 0; j < 2; ++j) {
+      const int l = 2 * pair + j;
+      d[j] = Quad{{0.0f, 0.0f, 0.0f, 0.0f}};
+      if (l <= deg || l > f.zonal) continue;
+      const float next = ((2.0f * l - 1.0f) / float(l)) * mu * p_l - (float(l - 1) / float(l)) * p_prev;
+      p_prev = p_l;
+      p_l = next;
+      const float y = w * (sqrtf((2.0f * l + 1.0f) * 0.07957747154594767f) * next);
+      d[j] = load_quad(z + size_t(l - deg - 1) * 4);
+      NEBULA_UNROLL
+      for (int b = 0; b < kMaxBands; ++b) d[j].v[b] *= y;
+    }
+    NEBULA_UNROLL
+    for (int b = 0; b < kMaxBands; ++b)
+      if (at[b] >= 0) {
+        const float* row = f.response[b] + at[b];
+        const Pair r0 = load_pair(row + 2 * pair), r1 = load_pair(row + f.stride + 2 * pair);
+        NEBULA_UNROLL
+        for (int j = 0; j < 2; ++j) {
+          s0[b] += r0.v[j] * d[j].v[b];
+          s1[b] += r1.v[j] * d[j].v[b];
+        }
+      }
+  }
+}
+
 // The light the dust at `point` (of V-band depth tau_v, so of scattering depth
 // s.albedo[b] tau_v s.extinction_ratio[b] per band of the marcher's scene s,
 // in field cell `cell`) sends towards the eye (unit to_eye) with the zonal
@@ -35,10 +88,11 @@ NEBULA_HD Pair load_pair(const float* p) {
 // kDeg bounds deg at compile time, the grid passes its degree as both.
 //
 // The response is linear in the D_l, so the stars are taken one after the
-// other: one star's Legendre recursion (Bonnet's) in registers at a time (all
-// of them at once, and D kept alive beside them, spilled at the grid pass'
-// 64 registers: 1.35 ms of a 1080p frame at 256^3). One sum per band: each
-// degree's response interpolated between the rows around tau_sct first.
+// other (add_zonal_star). Each band's two table rows around tau_sct are
+// summed apart and interpolated once at the end, and the blend with the
+// harmonics' own response, (1 - w) own + w zonal, is folded into the sums
+// (they start at (1 - w) own, every zonal term carries w): only the sums, the
+// rows and where tau_sct lies between them stay alive through the stars.
 template <int kDeg, class Scene>
 NEBULA_HD bool zonal_scattered_light(const Scene& s, const DiffuseView& f, float tau_v, size_t cell,
                                      Vec3 point, Vec3 to_eye, const float (&D)[kMaxBands][kDeg + 1],
@@ -46,73 +100,45 @@ NEBULA_HD bool zonal_scattered_light(const Scene& s, const DiffuseView& f, float
                                      bool clamp = true) {
   const float w = f.zonal_weight(point, to_eye);
   if (!(w > 0.0f)) return false;
-  float sum[kMaxBands] = {}, frac[kMaxBands] = {}, own[kMaxBands] = {};
-  const float* row[kMaxBands] = {};
+  float s0[kMaxBands] = {}, s1[kMaxBands] = {};
+  int at[kMaxBands];  // the lower row's offset in f.response[b]; -1: the band has no field
   NEBULA_UNROLL
   for (int b = 0; b < kMaxBands; ++b) {
+    at[b] = -1;
     if (!(b < s.n_bands && f.has[b])) continue;
-    // tau_sct recomputed where used (twice) rather than kept across the stars' loop.
     const float tau_sct = s.albedo[b] * tau_v * s.extinction_ratio[b];
-    row[b] = f.response_row(b, tau_sct, &frac[b]);
+    float frac = 0.0f;
+    const float* row = f.response_row(b, tau_sct, &frac);
+    at[b] = int(row - f.response[b]);
+    float h0 = 0.0f, h1 = 0.0f;  // the harmonics' degrees under the zonal response
     NEBULA_UNROLL
     for (int l = 0; l <= kDeg; ++l) {
       if (l > deg) break;
-      const float r = row[b][l] + frac[b] * (row[b][f.stride + l] - row[b][l]);
-      sum[b] += r * D[b][l];
+      h0 += row[l] * D[b][l];
+      h1 += row[f.stride + l] * D[b][l];
     }
     float own_peak = 0.0f;
-    own[b] = f.scattered<kDeg>(b, tau_sct, D[b], &own_peak, deg);
+    const float own = (1.0f - w) * f.scattered<kDeg>(b, tau_sct, D[b], &own_peak, deg);
+    s0[b] = own + w * h0;
+    s1[b] = own + w * h1;
   }
-  const int n_zonal = f.zonal - deg;
+  const size_t n_zonal = size_t(f.zonal - deg);
   const float* block = f.packed + (cell * size_t(f.coeffs) + size_t(sh_count(deg))) * 4;
-  for (int k = 0; k < f.zonal_stars; ++k) {
-    const Vec3 r = point - f.zonal_star[k];
-    const float len = length(r);
-    const float mu = len > 0.0f ? dot(to_eye, r) / len : to_eye.z;
-    float p_prev = 1.0f, p_l = mu;  // P_0 and P_1, then P_{l-1} and P_l
-    NEBULA_UNROLL
-    for (int l = 1; l < kDeg; ++l) {
-      if (l >= deg) break;
-      const float next = ((2.0f * l + 1.0f) * mu * p_l - float(l) * p_prev) / float(l + 1);
-      p_prev = p_l;
-      p_l = next;
-    }
-    if (deg == 0) p_l = 1.0f, p_prev = 0.0f;  // P_0 and "P_-1" (its weight is 0 below)
-    // Two degrees at a time: one 8-byte load per row and band serves both
-    // (rows of neighbouring voxels differ, so each scalar load is a gather);
-    // unrolled, so that every degree's constants are known at compile time.
-    const float* z = block + size_t(k) * n_zonal * 4;
-    NEBULA_UNROLL
-    for (int pair = 0; pair < kMaxZonalDegree / 2 + 1; ++pair) {
-      if (2 * pair + 1 <= deg) continue;  // both degrees within the harmonics
-      if (2 * pair > f.zonal) break;
-      Quad d[2];  // y_l Z_l per band, l = 2 pair + j (0 outside deg < l <= zonal)
-      NEBULA_UNROLL
-      for (int j = 0; j < 2; ++j) {
-        const int l = 2 * pair + j;
-        d[j] = Quad{{0.0f, 0.0f, 0.0f, 0.0f}};
-        if (l <= deg || l > f.zonal) continue;
-        const float next = ((2.0f * l - 1.0f) / float(l)) * mu * p_l - (float(l - 1) / float(l)) * p_prev;
-        p_prev = p_l;
-        p_l = next;
-        const float y = sqrtf((2.0f * l + 1.0f) * 0.07957747154594767f) * next;  // Y_l0: sqrt((2l + 1) / (4 pi)) P_l
-        d[j] = load_quad(z + size_t(l - deg - 1) * 4);
-        NEBULA_UNROLL
-        for (int b = 0; b < kMaxBands; ++b) d[j].v[b] *= y;
-      }
-      NEBULA_UNROLL
-      for (int b = 0; b < kMaxBands; ++b)
-        if (row[b]) {
-          const Pair r0 = load_pair(row[b] + 2 * pair), r1 = load_pair(row[b] + f.stride + 2 * pair);
-          NEBULA_UNROLL
-          for (int j = 0; j < 2; ++j) sum[b] += (r0.v[j] + frac[b] * (r1.v[j] - r0.v[j])) * d[j].v[b];
-        }
-    }
+  // Unrolled to the most zonal stars, leaving at the scene's count: a run-time
+  // loop around the inlined body spilled 156 bytes at the grid pass' 64
+  // registers, the straight code 24 (ptxas, sm_90).
+  NEBULA_UNROLL
+  for (int k = 0; k < kMaxZonalStars; ++k) {
+    if (k >= f.zonal_stars) break;
+    add_zonal_star<kDeg>(f, block + size_t(k) * n_zonal * 4, point - f.zonal_star[k], to_eye, w, deg, at, s0, s1);
   }
   NEBULA_UNROLL
   for (int b = 0; b < kMaxBands; ++b)
-    if (row[b]) {
-      light[b] = own[b] + w * (sum[b] - own[b]);
+    if (at[b] >= 0) {
+      // Where tau_sct lies between the rows, found again rather than kept through the stars.
+      float frac = 0.0f;
+      f.response_row(b, s.albedo[b] * tau_v * s.extinction_ratio[b], &frac);
+      light[b] = s0[b] + frac * (s1[b] - s0[b]);
       if (clamp) light[b] = fmaxf(0.0f, light[b]);
       peak[b] = f.peak(b, s.albedo[b] * tau_v * s.extinction_ratio[b], w);
     }

@@ -36,19 +36,30 @@ namespace {
 // 64 registers. With zonal degrees the compiler took 128 (22% occupancy,
 // latency-bound): the 1080p frame with them went 8.91-8.93 ms -> 8.40-8.41 ms
 // (H100; 3, 5, 6 and 8 blocks: 8.53, 8.76, 9.14 and 10.36 ms); without zonal
-// degrees the frame did not change (docs/performance.md). The zonal kernel
-// has its own bound, measured apart.
+// degrees the frame did not change (docs/performance.md).
 #ifndef NEBULA_DIFFUSE_LIGHT_MIN_BLOCKS
 #define NEBULA_DIFFUSE_LIGHT_MIN_BLOCKS 4
 #endif
+// The zonal kernel: blocks of 128, 7 per SM, so 72 registers (8 bytes
+// spilled; 64 registers spilled 20 and were L1-bound on the spills, 80 left
+// 24 warps an SM): the zonal 1080p frame 6.974-6.976 ms against 7.006-7.017
+// (256 x 4) and 7.081-7.087 (256 x 3) on an H200 (docs/performance.md).
 #ifndef NEBULA_DIFFUSE_ZONAL_MIN_BLOCKS
-#define NEBULA_DIFFUSE_ZONAL_MIN_BLOCKS 4
+#define NEBULA_DIFFUSE_ZONAL_MIN_BLOCKS 7
 #endif
+#ifndef NEBULA_DIFFUSE_ZONAL_BLOCK
+#define NEBULA_DIFFUSE_ZONAL_BLOCK 128
+#endif
+
+// Threads per block of the per-view pass.
+template <bool kZonal>
+constexpr int kDiffuseLightBlock = kZonal ? NEBULA_DIFFUSE_ZONAL_BLOCK : 256;
 
 // One thread per voxel: the diffuse field's light towards this view's eye
 // (raycast/diffuse_light.h).
 template <int kDeg, bool kZonal>
-__global__ void __launch_bounds__(256, kZonal ? NEBULA_DIFFUSE_ZONAL_MIN_BLOCKS : NEBULA_DIFFUSE_LIGHT_MIN_BLOCKS)
+__global__ void __launch_bounds__(kDiffuseLightBlock<kZonal>,
+                                  kZonal ? NEBULA_DIFFUSE_ZONAL_MIN_BLOCKS : NEBULA_DIFFUSE_LIGHT_MIN_BLOCKS)
     diffuse_light_kernel(MarchScene scene, Camera camera, DiffuseLightPlanes out) {
   const GridShape& g = scene.density.shape;
   const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
@@ -211,7 +222,9 @@ double render_cuda_to_device(const RenderInputs& in, float* pixels, unsigned lon
       }
     dispatch_diffuse_degree(scene.diffuse.degree, [&](auto degree) {
       dispatch_zonal(scene, [&](auto zonal) {
-        diffuse_light_kernel<degree(), zonal()><<<voxel_blocks, 256>>>(scene, in.camera, planes);
+        constexpr int threads = kDiffuseLightBlock<zonal()>;
+        diffuse_light_kernel<degree(), zonal()>
+            <<<unsigned((count + threads - 1) / threads), threads>>>(scene, in.camera, planes);
       });
     });
     NEBULA_CUDA_CHECK(cudaGetLastError());
@@ -273,10 +286,11 @@ DiffuseLightArrays diffuse_light_arrays_cuda(const RenderInputs& in) {
       planes.band[b] = made(out.device_light[size_t(b)]);
       planes.peak[b] = made(out.device_peak[size_t(b)]);
     }
-  const unsigned voxel_blocks = static_cast<unsigned>((count + 255) / 256);
   dispatch_diffuse_degree(scene.diffuse.degree, [&](auto degree) {
     dispatch_zonal(scene, [&](auto zonal) {
-      diffuse_light_kernel<degree(), zonal()><<<voxel_blocks, 256>>>(scene, in.camera, planes);
+      constexpr int threads = kDiffuseLightBlock<zonal()>;
+      diffuse_light_kernel<degree(), zonal()>
+          <<<unsigned((count + threads - 1) / threads), threads>>>(scene, in.camera, planes);
     });
   });
   NEBULA_CUDA_CHECK(cudaGetLastError());
