@@ -36,14 +36,16 @@ void print_multiple_scattering(const RunReport& r) {
   const DiffuseReport& d = r.diffuse;
   if (d.done && d.axial) {
     std::printf("  diffuse field (light scattered between cells): %zu band(s) x %llu photons through the map voxelized "
-                "to %dx%dx%d, harmonics to degree %d on %d x %d (x, r) cells of %g pc, ring averages; %.3g s (photon "
-                "passes %.3g s); noise of one 3D cell before the ring average, relative L2 of its l = 0 part:",
+                "to %dx%dx%d, harmonics to degree %d (response %s) on %d x %d (x, r) cells of %g pc, ring averages; "
+                "%.3g s (photon passes %.3g s); noise of one 3D cell before the ring average, relative L2 of its l = 0 "
+                "part:",
                 d.bands, (unsigned long long)d.photons_per_band, d.photon_grid.nx, d.photon_grid.ny, d.photon_grid.nz,
-                d.order, d.cells.nx, d.cells.ny, d.cells.voxel, d.wall_seconds, d.seconds);
+                d.order, d.lanczos ? "Lanczos-tapered" : "untapered", d.cells.nx, d.cells.ny, d.cells.voxel, d.wall_seconds, d.seconds);
   } else if (d.done) {
     std::printf("  diffuse field (light scattered between voxels): %zu band(s) x %llu photons, harmonics to degree %d ",
                 d.bands, (unsigned long long)d.photons_per_band, d.order);
     if (d.zonal > 0) std::printf("and zonal degrees to %d of %d star(s)' light ", d.zonal, d.zonal_stars);
+    std::printf("(response %s) ", d.lanczos ? "Lanczos-tapered" : "untapered");
     std::printf("on %dx%dx%d cells of %d voxel(s); %.3g s (photon passes %.3g s); noise, relative L2 of its l = 0 part:",
                 d.cells.nx, d.cells.ny, d.cells.nz, d.voxels_per_cell, d.wall_seconds, d.seconds);
     if (d.reused) std::printf(" [reused: nothing it depends on changed; figures of its bake]");

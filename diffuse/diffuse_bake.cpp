@@ -313,7 +313,7 @@ std::vector<DiffuseField> bake_diffuse_shared(const DensityGrid& density,
       if (known) {
         field.response[b] = *known;
       } else {
-        field.response[b] = delta_m_response(*band.table, o.degree, o.zonal);
+        field.response[b] = delta_m_response(*band.table, o.degree, o.zonal, o.taper);
         responses.emplace_back(band.table, &field.response[b]);
       }
       field.response_tau_max[b] = static_cast<float>(band.table->tau_max());

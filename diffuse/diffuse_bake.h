@@ -43,6 +43,7 @@ struct DiffuseBakeOptions {
   // "diffuse_zonal": degrees degree + 1 .. this of each of the brightest
   // kMaxZonalStars stars' light, about the direction from the star (0: none).
   int zonal = 0;
+  DiffuseTaper taper = DiffuseTaper::Auto;  // "diffuse_taper" (delta_m_response, resolved_taper)
   // Every band's photons draw the same random numbers (band 0's streams), so
   // that the fields of bands that differ a little (the spectral renderer's
   // attenuations) differ by their physics more than by their noise: the same

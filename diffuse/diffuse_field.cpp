@@ -132,7 +132,7 @@ double lanczos_sigma(int l, int degree) {
   return std::sin(x) / x;
 }
 
-std::vector<float> delta_m_response(const ScatteringTable& table, int degree, int zonal) {
+std::vector<float> delta_m_response(const ScatteringTable& table, int degree, int zonal, DiffuseTaper taper) {
   if (degree < 0 || degree > kMaxDiffuseDegree)
     throw ParameterError("diffuse_order", "must be 0 to " + std::to_string(kMaxDiffuseDegree) + ", got " +
                                               std::to_string(degree));
@@ -144,17 +144,19 @@ std::vector<float> delta_m_response(const ScatteringTable& table, int degree, in
   const int stride = has_zonal ? diffuse_zonal_stride(degree, zonal) : diffuse_response_stride(degree);
   const int own_at = has_zonal ? diffuse_response_stride(zonal) : 0;
   std::vector<float> out(size_t(table.n_tau()) * stride, 0.0f);
-  // sigma_l (p_l - p_{cut+1}) for l <= cut, then the peak, from `at`.
-  auto put = [](const double* row, int cut, float* o) {
+  const bool lanczos = resolved_taper(taper, degree, zonal) == DiffuseTaper::Lanczos;
+  // p_l - p_{cut+1} (tapered: times sigma_l) for l <= cut, then the peak.
+  auto put = [](const double* row, int cut, bool lanczos, float* o) {
     const double peak = std::max(0.0, row[cut + 1]);
-    for (int l = 0; l <= cut; ++l) o[l] = static_cast<float>((row[l] - peak) * lanczos_sigma(l, cut));
+    for (int l = 0; l <= cut; ++l)
+      o[l] = static_cast<float>((row[l] - peak) * (lanczos ? lanczos_sigma(l, cut) : 1.0));
     o[cut + 1] = static_cast<float>(peak);
   };
   for (int i = 0; i < table.n_tau(); ++i) {
     const double* row = p.data() + size_t(i) * (n + 1);
     float* o = out.data() + size_t(i) * stride;
-    if (has_zonal) put(row, zonal, o);
-    put(row, degree, o + own_at);
+    if (has_zonal) put(row, zonal, lanczos, o);
+    put(row, degree, lanczos, o + own_at);
   }
   return out;
 }

@@ -43,6 +43,7 @@
 #include "core/device_mirror.h"
 #include "core/grid.h"
 #include "core/hd.h"
+#include "diffuse/diffuse_taper.h"
 #include "diffuse/spherical_harmonics.h"
 #include "tables/scattering_table.h"
 
@@ -267,12 +268,16 @@ struct DiffuseField {
 std::vector<double> legendre_moments(const ScatteringTable& table, int n);
 
 // The response a field of this degree uses, per row (diffuse_response_stride
-// values): the forward peak p_{N+1} (0 where it is negative, in thick voxels that scatter
-// mostly backwards) and sigma_l (p_l - peak) for l <= N, then zeros.
-// With zonal > degree each row holds first the zonal response, sigma_l
-// (p_l - p_{zonal+1}) for l <= zonal with the factors of a cut at `zonal`
-// and that peak, then the harmonics' own as above (diffuse_zonal_stride).
-std::vector<float> delta_m_response(const ScatteringTable& table, int degree, int zonal = 0);
+// values): p_l - peak for l <= N, then the forward peak p_{N+1} (0 where it is
+// negative, in thick voxels that scatter mostly backwards), then zeros. With
+// zonal > degree each row holds first the zonal response, p_l - p_{zonal+1}
+// for l <= zonal and that peak, then the harmonics' own as above
+// (diffuse_zonal_stride). The Lanczos taper (resolved_taper) multiplies each
+// p_l - peak by sigma_l of its cut: it smooths the series' ringing but also
+// its anisotropy, and so moves light between the directions the eye sees the
+// field from (docs/diffuse.md, "Truncation").
+std::vector<float> delta_m_response(const ScatteringTable& table, int degree, int zonal = 0,
+                                    DiffuseTaper taper = DiffuseTaper::Auto);
 // Lanczos's sigma factor of degree l in a series cut at `degree`: sinc(l / (degree + 1)), 1 at l = 0.
 double lanczos_sigma(int l, int degree);
 

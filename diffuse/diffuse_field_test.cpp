@@ -39,12 +39,15 @@ TEST(DiffuseResponse, ThinTableGivesTheHgMoments) {
   }
 }
 
-// The delta-M split: a peak of p_{N+1}, the rest p_l - p_{N+1}, cut with
-// Lanczos's sigma factors.
+// The delta-M split: a peak of p_{N+1}, the rest p_l - p_{N+1}, as it is
+// or tapered by Lanczos's sigma factors; without zonal degrees the default
+// (auto) leaves it as it is.
 TEST(DiffuseResponse, DeltaMSplitsOffTheForwardPeak) {
   const ScatteringTable t = thin_table(0.9, 720);
+  for (DiffuseTaper taper : {DiffuseTaper::None, DiffuseTaper::Lanczos})
   for (int degree = 0; degree <= kMaxDiffuseDegree; ++degree) {
-    const std::vector<float> r = delta_m_response(t, degree);
+    const std::vector<float> r = delta_m_response(t, degree, 0, taper);
+    const auto sigma = [&](int l) { return taper == DiffuseTaper::Lanczos ? lanczos_sigma(l, degree) : 1.0; };
     const std::vector<double> p = legendre_moments(t, degree + 1);
     const int stride = diffuse_response_stride(degree);
     ASSERT_EQ(stride % 4, 0) << "rows are whole vector loads";
@@ -57,20 +60,28 @@ TEST(DiffuseResponse, DeltaMSplitsOffTheForwardPeak) {
       EXPECT_NEAR(row[degree + 1], peak, 1e-6 * (1 + peak));
       EXPECT_NEAR(row[degree + 1], t.tau[i] * std::pow(0.9, degree + 1), 2e-3 * t.tau[i]);
       for (int l = 0; l <= degree; ++l)
-        EXPECT_NEAR(row[l], (p[size_t(i) * (degree + 2) + l] - peak) * lanczos_sigma(l, degree), 1e-6 * (1 + t.tau[i]));
+        EXPECT_NEAR(row[l], (p[size_t(i) * (degree + 2) + l] - peak) * sigma(l), 1e-6 * (1 + t.tau[i]))
+            << to_string(taper) << " degree " << degree << " row " << i << " l " << l;
     }
   }
+  EXPECT_EQ(delta_m_response(t, 3), delta_m_response(t, 3, 0, DiffuseTaper::None)) << "untapered by default";
+  EXPECT_EQ(delta_m_response(t, 3, 0, DiffuseTaper::Auto), delta_m_response(t, 3, 0, DiffuseTaper::None));
+  EXPECT_NE(delta_m_response(t, 3), delta_m_response(t, 3, 0, DiffuseTaper::Lanczos)) << "the taper changes the rows";
   EXPECT_THROW(delta_m_response(t, kMaxDiffuseDegree + 1), ParameterError);
 }
 
 // With zonal degrees a row holds two delta-M responses, each padded to whole
 // vector loads: the zonal one cut at the zonal degree (its peak p_{K+1}),
 // then the harmonics' own, exactly the row a field without zonal degrees has.
+// The taper applies to both, each with the sigma factors of its own cut; with
+// zonal degrees the default (auto) is the Lanczos taper.
 TEST(DiffuseResponse, ZonalRowsHoldTheZonalResponseThenTheHarmonicsOwn) {
   const ScatteringTable t = thin_table(0.9, 720);
   const int degree = 3, zonal = 16;
-  const std::vector<float> r = delta_m_response(t, degree, zonal);
-  const std::vector<float> own = delta_m_response(t, degree);
+  for (DiffuseTaper taper : {DiffuseTaper::None, DiffuseTaper::Lanczos}) {
+  const std::vector<float> r = delta_m_response(t, degree, zonal, taper);
+  const std::vector<float> own = delta_m_response(t, degree, 0, taper);
+  const auto sigma = [&](int l) { return taper == DiffuseTaper::None ? 1.0 : lanczos_sigma(l, zonal); };
   const std::vector<double> p = legendre_moments(t, zonal + 1);
   const int stride = diffuse_zonal_stride(degree, zonal), own_at = diffuse_response_stride(zonal);
   ASSERT_EQ(stride % 4, 0);
@@ -85,17 +96,25 @@ TEST(DiffuseResponse, ZonalRowsHoldTheZonalResponseThenTheHarmonicsOwn) {
     EXPECT_NEAR(row[zonal + 1], peak, 1e-6 * (1 + peak));
     EXPECT_NEAR(row[zonal + 1], t.tau[i] * std::pow(0.9, zonal + 1), 2e-3 * t.tau[i]);
     for (int l = 0; l <= zonal; ++l)
-      EXPECT_NEAR(row[l], (m[l] - peak) * lanczos_sigma(l, zonal), 1e-6 * (1 + t.tau[i])) << "row " << i << " l " << l;
+      EXPECT_NEAR(row[l], (m[l] - peak) * sigma(l), 1e-6 * (1 + t.tau[i]))
+          << to_string(taper) << " row " << i << " l " << l;
     for (int j = zonal + 2; j < own_at; ++j) EXPECT_EQ(row[j], 0.0f) << "padding";
     for (int j = 0; j < own_stride; ++j)
       EXPECT_EQ(row[own_at + j], own[size_t(i) * own_stride + j]) << "the harmonics' own response, row " << i;
   }
+  }
+  const std::vector<float> own = delta_m_response(t, degree);
+  EXPECT_EQ(delta_m_response(t, degree, zonal), delta_m_response(t, degree, zonal, DiffuseTaper::Lanczos))
+      << "auto: Lanczos where there are zonal degrees";
+  EXPECT_EQ(resolved_taper(DiffuseTaper::Auto, 3, 24), DiffuseTaper::Lanczos);
+  EXPECT_EQ(resolved_taper(DiffuseTaper::Auto, 4, 0), DiffuseTaper::None);
+  EXPECT_EQ(resolved_taper(DiffuseTaper::None, 3, 24), DiffuseTaper::None);
   EXPECT_EQ(delta_m_response(t, degree, 0), own) << "no zonal degrees: the rows as before";
   EXPECT_THROW(delta_m_response(t, degree, kMaxZonalDegree + 1), ParameterError);
 }
 
 template <int kDeg>
-void check_truncated_series(const ScatteringTable& t) {
+void check_truncated_series(const ScatteringTable& t, DiffuseTaper taper) {
   const int degree = kDeg;
   DiffuseField f;
   f.degree = degree;
@@ -108,7 +127,7 @@ void check_truncated_series(const ScatteringTable& t) {
   std::vector<float> c(y, y + sh_count(degree));
   for (float& v : c) v *= E;
   f.set_band_coeffs(0, c);
-  f.response = {delta_m_response(t, degree)};
+  f.response = {delta_m_response(t, degree, 0, taper)};
   f.response_tau_max = {float(t.tau_max())};
   const DiffuseView v = f.view();
   ASSERT_TRUE(v.has[0]);
@@ -124,7 +143,8 @@ void check_truncated_series(const ScatteringTable& t) {
     const double peak = tau * std::pow(0.6, degree + 1);
     double expected = 0;
     for (int l = 0; l <= degree; ++l) {
-      const double sigma = l == 0 ? 1.0 : std::sin(kPiD * l / (degree + 1)) / (kPiD * l / (degree + 1));
+      const double x = kPiD * l / (degree + 1);
+      const double sigma = l == 0 || taper == DiffuseTaper::None ? 1.0 : std::sin(x) / x;
       expected += (2 * l + 1) / (4 * kPiD) * (tau * std::pow(0.6, l) - peak) * sigma * p[l];
     }
     float got_peak = -1;
@@ -140,12 +160,13 @@ void check_truncated_series(const ScatteringTable& t) {
 
 // A parallel beam of irradiance E along d0 has harmonics E Y_k(d0); the
 // voxel's response towards e must be E times the delta-M rest's Legendre
-// series truncated at the field's degree with Lanczos's factors (the
-// addition theorem).
+// series truncated at the field's degree, with Lanczos's factors where the
+// taper asks for them (the addition theorem).
 TEST(DiffuseResponse, ScatteredLightIsTheTruncatedLegendreSeries) {
   const ScatteringTable t = thin_table(0.6, 180, 2.0, 5);
-  for (int degree = 0; degree <= kMaxDiffuseDegree; ++degree)
-    dispatch_diffuse_degree(degree, [&](auto deg) { check_truncated_series<deg()>(t); });
+  for (DiffuseTaper taper : {DiffuseTaper::None, DiffuseTaper::Lanczos})
+    for (int degree = 0; degree <= kMaxDiffuseDegree; ++degree)
+      dispatch_diffuse_degree(degree, [&](auto deg) { check_truncated_series<deg()>(t, taper); });
 }
 
 TEST(DiffuseCells, PowersOfTwoWithAtLeastTheCellsAsked) {

@@ -43,7 +43,7 @@ std::string photon_key(const std::string& bake, const Scene& scene, const SceneB
   std::string key = bake + "|mode " + to_string(scene.multiple_scattering);
   const DiffuseSettings& d = scene.diffuse;
   key += "|order " + std::to_string(resolved_order(d, scene.dust.g)) + " zonal " + std::to_string(resolved_zonal(d, scene.dust.g)) + " cells " + std::to_string(d.cells) + " photons " +
-         std::to_string(d.photons) + " seed " + std::to_string(d.seed);
+         std::to_string(d.photons) + " seed " + std::to_string(d.seed) + " taper " + to_string(d.taper);
   for (size_t b = 0; b < bands.bands.size(); ++b)
     key += "|" + bands.bands[b].name + " " + exact(bands.bands[b].extinction_ratio) + " " + exact(bands.bands[b].g);
   for (const StarLight& s : bands.stars) {

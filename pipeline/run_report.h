@@ -53,6 +53,7 @@ struct DiffuseReport {
   int order = 0;
   int zonal = 0;               // zonal degrees of the brightest stars' light (0: none)
   int zonal_stars = 0;
+  bool lanczos = false;        // the response tapered by Lanczos's sigma factors (render.diffuse_taper)
   GridShape cells;             // the field's cells ({along the axis, from it, 1} for an axial map)
   int voxels_per_cell = 1;     // along each axis
   bool axial = false;          // an axial map's field: photons on `photon_grid`, the map voxelized

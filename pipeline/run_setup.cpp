@@ -220,6 +220,7 @@ DiffuseBakeOptions diffuse_options(const Scene& scene) {
   options.cells = scene.diffuse.cells;
   options.photons = scene.diffuse.photons;
   options.seed = scene.diffuse.seed;
+  options.taper = scene.diffuse.taper;
   return options;
 }
 
@@ -231,6 +232,7 @@ DiffuseReport diffuse_report(const std::vector<DiffuseBand>& bands, const Diffus
   r.order = options.degree;
   r.zonal = field.n_zonal() > 0 ? field.zonal : 0;
   r.zonal_stars = r.zonal > 0 ? field.zonal_stars : 0;
+  r.lanczos = resolved_taper(options.taper, options.degree, options.zonal) == DiffuseTaper::Lanczos;
   r.cells = field.cells;
   r.voxels_per_cell = voxels_per_cell;
   r.photons_per_band = options.photons;

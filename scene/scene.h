@@ -16,6 +16,7 @@
 #include "core/display.h"
 #include "core/grid.h"
 #include "core/vec3.h"
+#include "diffuse/diffuse_taper.h"
 #include "illumination/extinction.h"
 #include "scene/camera_path.h"
 #include "illumination/passband.h"
@@ -109,6 +110,7 @@ struct DiffuseSettings {
   int zonal = kZonalAuto;
   uint64_t photons = 1u << 20;   // per band
   uint64_t seed = 1;
+  DiffuseTaper taper = DiffuseTaper::Auto;  // the response's (docs/diffuse.md, "Truncation"; resolved_taper)
 };
 
 // The zonal degree a scene's field uses (resolving "auto" by the bands' g).

@@ -71,7 +71,7 @@ const std::initializer_list<std::string_view> kSpectralDustKeys = {"wavelength_n
 const std::initializer_list<std::string_view> kSpectralEmissionKeys = {"line_nm", "continuum", "range_nm", "file",
                                                                        "dataset", "scale"};
 const std::initializer_list<std::string_view> kRenderKeys = {
-    "levels", "multiple_scattering", "diffuse_order", "diffuse_zonal", "diffuse_cells", "diffuse_photons", "diffuse_seed",
+    "levels", "multiple_scattering", "diffuse_order", "diffuse_zonal", "diffuse_cells", "diffuse_photons", "diffuse_seed", "diffuse_taper",
     "samples_per_pixel", "star_pixels"};
 const std::initializer_list<std::string_view> kAxialKeys = {
     "synthetic", "file", "image", "dataset", "emission_prefix", "tau_channel", "emission_channels", "nx", "nr",
@@ -903,6 +903,11 @@ void Parser::parse_render(const toml::table& root, Scene& scene) const {
   };
   count("diffuse_photons", d.photons);
   count("diffuse_seed", d.seed);
+  if (const toml::node* v = t.get("diffuse_taper")) {
+    const std::string taper = lower(string(*v, "render.diffuse_taper"));
+    if (!parse_diffuse_taper(taper, d.taper))
+      fail("render.diffuse_taper", "'" + taper + "' is not a taper (known: auto, none, lanczos)");
+  }
   if (const toml::node* v = t.get("samples_per_pixel")) {
     scene.samples_per_pixel = small_integer(*v, "render.samples_per_pixel");
     if (auto issue = scene_detail::samples_per_pixel_issue(scene.samples_per_pixel)) fail(issue->key, issue->reason);

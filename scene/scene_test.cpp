@@ -404,6 +404,24 @@ TEST_F(SceneFile, DiffuseZonalIsAutoOrAWholeNumberAboveTheOrder) {
   refused("zonal_minus_one", kBase + std::string("\n[render]\ndiffuse_zonal = -1\n"), {"render.diffuse_zonal", "\"auto\""});
 }
 
+// render.diffuse_taper: "auto" (the default), "none" or "lanczos", any case;
+// anything else refused by name.
+TEST_F(SceneFile, DiffuseTaperIsAutoNoneOrLanczos) {
+  EXPECT_EQ(load_scene(write_text("taper_base.toml", kBase)).diffuse.taper, DiffuseTaper::Auto);
+  EXPECT_EQ(load_scene(write_text("taper_l.toml", kBase + std::string("\n[render]\ndiffuse_taper = \"Lanczos\"\n")))
+                .diffuse.taper,
+            DiffuseTaper::Lanczos);
+  EXPECT_EQ(load_scene(write_text("taper_n.toml", kBase + std::string("\n[render]\ndiffuse_taper = \"NONE\"\n")))
+                .diffuse.taper,
+            DiffuseTaper::None);
+  EXPECT_EQ(load_scene(write_text("taper_a.toml", kBase + std::string("\n[render]\ndiffuse_taper = \"auto\"\n")))
+                .diffuse.taper,
+            DiffuseTaper::Auto);
+  refused("taper_word", kBase + std::string("\n[render]\ndiffuse_taper = \"zonal\"\n"),
+          {"render.diffuse_taper", "auto, none, lanczos"});
+  refused("taper_number", kBase + std::string("\n[render]\ndiffuse_taper = 1\n"), {"render.diffuse_taper"});
+}
+
 // render.star_pixels: true by default (the pixels at a star's image marched
 // with many rays each), false turns it off; anything but a boolean refused.
 TEST_F(SceneFile, StarPixelsAreOnUnlessTurnedOff) {
