@@ -43,7 +43,7 @@ std::string photon_key(const std::string& bake, const Scene& scene, const SceneB
   std::string key = bake + "|mode " + to_string(scene.multiple_scattering);
   const DiffuseSettings& d = scene.diffuse;
   key += "|order " + std::to_string(resolved_order(d, scene.dust.g)) + " zonal " + std::to_string(resolved_zonal(d, scene.dust.g)) + " cells " + std::to_string(d.cells) + " photons " +
-         std::to_string(d.photons) + " seed " + std::to_string(d.seed) + " taper " + to_string(d.taper);
+         std::to_string(d.photons) + " seed " + std::to_string(d.seed);
   for (size_t b = 0; b < bands.bands.size(); ++b)
     key += "|" + bands.bands[b].name + " " + exact(bands.bands[b].extinction_ratio) + " " + exact(bands.bands[b].g);
   for (const StarLight& s : bands.stars) {
@@ -53,11 +53,12 @@ std::string photon_key(const std::string& bake, const Scene& scene, const SceneB
   return key;
 }
 
-// What the field depends on: its photons, and each band's albedo and table.
+// What the field depends on: its photons, and each band's albedo and table
+// with the response's taper.
 std::string diffuse_key(const std::string& bake, const Scene& scene, const SceneBands& bands, const RenderOptions& o) {
   std::string key = photon_key(bake, scene, bands);
   if (key.empty()) return "";
-  key += "|table photons " + std::to_string(o.table_photons);
+  key += "|table photons " + std::to_string(o.table_photons) + " taper " + to_string(scene.diffuse.taper);
   for (size_t b = 0; b < bands.bands.size(); ++b)
     key += "|" + bands.bands[b].name + " albedo " + exact(bands.bands[b].albedo) + " " + scene.dust.table_files[b];
   return key;

@@ -533,5 +533,23 @@ TEST_F(RenderScene, APreparationLeftWholeGivesTheSameFrame) {
   EXPECT_EQ(render_prepared(reused, edited.camera).image.pixels, render_prepared(fresh, edited.camera).image.pixels);
 }
 
+// The field is reused while nothing it depends on changes; its response's
+// taper is one of those things (the photons are not: they do not depend on it).
+TEST_F(RenderScene, ChangingTheTaperRemakesTheField) {
+  const std::string few_photons = "[render]\ndiffuse_photons = 8192\n";
+  const Scene plain = scene(few_photons), again = scene(few_photons),
+              tapered_scene = scene(few_photons + "diffuse_taper = \"lanczos\"\n");
+  const PreparedGrid first = prepare_grid(plain, options());
+  ASSERT_TRUE(first.report.diffuse.done);
+  EXPECT_FALSE(first.report.diffuse.lanczos) << "auto at g = 0.6: untapered";
+  const PreparedGrid same = prepare_grid(again, options(), first);
+  EXPECT_TRUE(same.report.diffuse.reused);
+  const PreparedGrid tapered = prepare_grid(tapered_scene, options(), first);
+  EXPECT_FALSE(tapered.report.diffuse.reused);
+  EXPECT_TRUE(tapered.report.diffuse.lanczos);
+  EXPECT_NE(render_prepared(tapered, tapered_scene.camera).image.pixels,
+            render_prepared(first, plain.camera).image.pixels);
+}
+
 }  // namespace
 }  // namespace nebula
