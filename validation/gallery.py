@@ -105,6 +105,13 @@ STUDIES = {
           "--set", "axial.shape_deform.frequency=8"])
         for kind in ("simplex", "fbm", "turbulence", "cellular")
     ]),
+    "spectral": ("spectral_light_between_voxels.png",
+                 "The spectral renderer (Barres 2023 projection, B, V, R filters) without and\n"
+                 "with the light scattered between voxels, beside the truth; same exposure",
+                 "scenes/fig12_spectral.toml", "shared", [
+        ("none", "spectral, no light scattered\nbetween voxels", ["--set", "render.multiple_scattering=none"]),
+        ("diffuse", "spectral (default,\ndiffuse field)", []),
+    ]),
     "axial_ms": ("axial_diffuse.png",
                  "An axial map, a = g = 0.6, optical depths up to about 5 from the star:\n"
                  "light scattered between texels left out, and the diffuse field (default); same exposure",

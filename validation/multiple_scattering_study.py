@@ -122,6 +122,14 @@ def pixel_error(fast, truth):
     return float(np.median(np.abs(F[known] / T[known] - 1))) if known.any() else None
 
 
+NOISY = 0.005  # a bias whose standard error is this or more is shown with it
+
+
+def noisy(stderr):
+    """' ± σ' for a bias the truth leaves uncertain by NOISY or more, else nothing."""
+    return f" ± {100 * stderr:.1f}%" if stderr >= NOISY else ""
+
+
 def merge(args):
     rows = []
     for path in args.merge.split(","):
@@ -173,7 +181,9 @@ def write_page(rows, args, albedos, gs, methods, elapsed):
                       " and the median per-pixel error |fast/truth − 1| over the pixels with signal whose truth is "
                       "known to 5%, but for the rim of the dust's image, where one ray per pixel meets or misses the "
                       "grid (every such pixel weighs alike; it includes the truth's own noise)") +
-           ". The method is [docs/diffuse.md](diffuse.md).\n"]
+           f". Where the truth leaves the bias uncertain by {100 * NOISY:g}% or more, its standard error follows it "
+           "(± σ): the truth's samples are heavy-tailed near a star (a path scattered close to it), so one pixel can "
+           "carry most of a total's uncertainty. The method is [docs/diffuse.md](diffuse.md).\n"]
     if args.note:
         out.append(args.note + "\n")
     scenes = list(dict.fromkeys(x["scene"] for x in rows))
@@ -188,7 +198,8 @@ def write_page(rows, args, albedos, gs, methods, elapsed):
                     sel = [x for x in rows if x["scene"] == scene and x["g"] == g and x["albedo"] == a and
                            x["method"] == method]
                     pixel = f"; {100 * sel[0]['pixel_error']:.1f}%" if sel and "pixel_error" in sel[0] else ""
-                    cells.append(f"{100 * sel[0]['bias']:+.1f}% ({sel[0]['excess']:.3f}{pixel})" if sel else "—")
+                    cells.append(f"{100 * sel[0]['bias']:+.1f}%{noisy(sel[0]['bias_stderr'])} "
+                                 f"({sel[0]['excess']:.3f}{pixel})" if sel else "—")
                 if any(c != "—" for c in cells):  # axial maps have no pyramid rows
                     out.append(f"| {scene} | {g:g} | " + " | ".join(cells) + " |")
         out.append("")
