@@ -50,6 +50,10 @@ constexpr uint32_t kPurposeTruth = 0x5054u;  // "PT"
 struct TruthStarView {
   Vec3 position;
   float power[kMaxBands];  // band power, L_sun
+  // Where the star appears in the image, in pixels from the top-left corner
+  // (core/camera.h project_point); in_image false where it appears nowhere.
+  float image_x = 0, image_y = 0;
+  bool in_image = false;
 };
 
 // Everything a path needs, by value (pointers to host or device memory).
@@ -71,6 +75,11 @@ struct PathScene {
   // Pixel-area sampling: sample k lies in stratum k mod side^2 of a side x
   // side grid over the pixel, at a uniform point in it (1: the pixel's centre).
   int pixel_side = 1;
+  // A stratum that holds a star's image, or lies within one stratum of it,
+  // draws its points with density proportional to 1 / (distance from the
+  // image's nearest point of the stratum) (sample_stratum below);
+  // false: uniformly, as every other stratum (tests compare the two).
+  bool star_strata = true;
 };
 
 struct PathCounters {
@@ -225,6 +234,84 @@ NEBULA_HD float trace_path(const PathScene& s, int b, Vec3 origin, Vec3 dir, Rng
   return radiance;
 }
 
+// A point of the square stratum [x0, x0 + h] x [y0, y0 + h] (image pixels) and
+// its weight, the uniform density over the square divided by the density drawn
+// with: E[weight f(point)] is the square's mean of f.
+struct StratumPoint {
+  float x, y, weight;
+};
+
+// A point drawn with density 1 / (Z rho) about (px, py), which lies in the
+// square (closed), rho the distance from it: the rays through a stratum that
+// holds a star's image pass at impact parameters b ~ rho, and their light
+// grows as 1/b (the equiangular estimate of a ray through dust at the star),
+// whose square has a logarithmically divergent mean over the square; with
+// this density each sample's weight Z rho / h^2 cancels it. The square is cut
+// into four triangles with apex (px, py), one per edge at height H from it;
+// a triangle's share of Z is the integral over its angles of the distance to
+// its edge, H (asinh(bB / H) - asinh(bA / H)), bA < bB the edge's ends'
+// offsets along it from the foot of the height. Within a triangle the angle
+// is drawn uniform in s = asinh(b / H) (density proportional to the distance
+// to the edge) and the point uniform along the line from the apex to the edge.
+NEBULA_HD StratumPoint sample_stratum_about(float x0, float y0, float h, float px, float py, float u0, float u1,
+                                            float u2) {
+  // Edges right, top, left, bottom: outward normal n, height H from the apex,
+  // direction t along the edge, its two corners' offsets along t from the foot.
+  const float nx[4] = {1, 0, -1, 0}, ny[4] = {0, -1, 0, 1};
+  const float H[4] = {x0 + h - px, py - y0, px - x0, y0 + h - py};
+  const float cx[4][2] = {{x0 + h, x0 + h}, {x0, x0 + h}, {x0, x0}, {x0, x0 + h}};
+  const float cy[4][2] = {{y0, y0 + h}, {y0, y0}, {y0, y0 + h}, {y0 + h, y0 + h}};
+  float lo[4], hi[4], W[4], Z = 0.0f;
+  for (int e = 0; e < 4; ++e) {
+    const float tx = -ny[e], ty = nx[e];
+    const float pa = (cx[e][0] - px) * tx + (cy[e][0] - py) * ty, pb = (cx[e][1] - px) * tx + (cy[e][1] - py) * ty;
+    lo[e] = fminf(pa, pb);
+    hi[e] = fmaxf(pa, pb);
+    W[e] = H[e] > 1e-7f * h ? H[e] * (asinhf(hi[e] / H[e]) - asinhf(lo[e] / H[e])) : 0.0f;
+    Z += W[e];
+  }
+  // The triangle: u0 through the cumulative shares (none of zero share).
+  float target = u0 * Z;
+  int e = 0;
+  while (e < 3 && (target >= W[e] || W[e] == 0.0f)) {
+    target -= W[e];
+    ++e;
+  }
+  while (W[e] == 0.0f) e = (e + 3) % 4;  // u0 rounded past the last share
+  const float tx = -ny[e], ty = nx[e];
+  const float s0 = asinhf(lo[e] / H[e]), s1 = asinhf(hi[e] / H[e]);
+  const float b = H[e] * sinhf(s0 + u1 * (s1 - s0));
+  // The point on the edge (the foot of the height plus b along it), then
+  // uniform along the way from the apex to it.
+  const float qx = H[e] * nx[e] + b * tx, qy = H[e] * ny[e] + b * ty;
+  const float rho = u2 * sqrtf(qx * qx + qy * qy);
+  StratumPoint out;
+  out.x = fminf(fmaxf(px + u2 * qx, x0), x0 + h);
+  out.y = fminf(fmaxf(py + u2 * qy, y0), y0 + h);
+  out.weight = Z * rho / (h * h);
+  return out;
+}
+
+// Sample point of stratum [x0, x0 + h]^2: about the first star whose image
+// lies in it or within one side h of it (star_strata), else uniform (weight
+// 1). An image outside the square is drawn about its nearest point of the
+// square, P': every point X of the (convex) square has |X - P| >= |X - P'|,
+// so the weight still bounds the 1/b of the rays there. A star on four
+// pixels' common corner lies, after rounding, a hair outside three of the four
+// strata that touch it; drawn uniformly, those gave the rare huge samples.
+NEBULA_HD StratumPoint sample_stratum(const PathScene& s, float x0, float y0, float h, float u0, float u1,
+                                      float u2) {
+  if (s.star_strata)
+    for (int k = 0; k < s.n_stars; ++k) {
+      const TruthStarView& star = s.stars[k];
+      if (!star.in_image) continue;
+      const float px = fminf(fmaxf(star.image_x, x0), x0 + h), py = fminf(fmaxf(star.image_y, y0), y0 + h);
+      if (fabsf(star.image_x - px) <= h && fabsf(star.image_y - py) <= h)
+        return sample_stratum_about(x0, y0, h, px, py, u0, u1, u2);
+    }
+  return StratumPoint{x0 + u0 * h, y0 + u1 * h, 1.0f};
+}
+
 // Samples [k0, k1) of pixel (x, y): per band the sum of the samples and of
 // their squares, in double. The samples depend only on (pixel, sample,
 // band), never on how a launch splits the range (the GPU gives a small
@@ -242,19 +329,23 @@ NEBULA_HD void trace_pixel_samples(const PathScene& s, const Camera& camera, int
   if (!centre && s.pixel_side == 1) return;
   const uint32_t pixel = static_cast<uint32_t>(y) * static_cast<uint32_t>(camera.width) + static_cast<uint32_t>(x);
   const int strata = s.pixel_side * s.pixel_side;
+  const float h = 1.0f / float(s.pixel_side);
   for (int b = 0; b < s.n_bands; ++b) {
     double sum = 0.0, sum2 = 0.0;
     for (int k = k0; k < k1; ++k) {
+      double weight = 1.0;
       if (strata > 1) {
         // The same sub-pixel point in every band (its own stream, band 0xFF).
         PathRng jitter(s.seed, pixel, static_cast<uint32_t>(k), 0xFFu);
         const int stratum = k % strata;
-        const float fx = x + (stratum % s.pixel_side + jitter.next()) / s.pixel_side;
-        const float fy = y + (stratum / s.pixel_side + jitter.next()) / s.pixel_side;
-        if (!camera.ray_through(fx, fy, origin, dir)) continue;  // outside the dome: no light (a zero sample)
+        const float u0 = jitter.next(), u1 = jitter.next(), u2 = jitter.next();
+        const StratumPoint p =
+            sample_stratum(s, x + (stratum % s.pixel_side) * h, y + (stratum / s.pixel_side) * h, h, u0, u1, u2);
+        weight = p.weight;
+        if (!camera.ray_through(p.x, p.y, origin, dir)) continue;  // outside the dome: no light (a zero sample)
       }
       PathRng rng(s.seed, pixel, static_cast<uint32_t>(k), static_cast<uint32_t>(b));
-      const double v = trace_path(s, b, origin, dir, rng, c);
+      const double v = weight * trace_path(s, b, origin, dir, rng, c);
       sum += v;
       sum2 += v * v;
     }

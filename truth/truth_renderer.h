@@ -4,6 +4,7 @@
 // sharing its samples when the image is small), with the variance of every
 // pixel's mean beside the image.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,7 @@ struct TruthInputs {
   float exposure = 1.0f;
   int spp = 16;            // samples per pixel and band, >= 2
   int pixel_side = 1;      // pixel-area sampling: side x side strata (1: the pixel's centre); spp a multiple of side^2
+  bool star_strata = true;  // a stratum holding a star's image samples about it (path_tracer.h sample_stratum)
   uint64_t seed = 1;
   int max_orders = 0;      // 0: all orders (the truth)
   int roulette_start = 3;
@@ -72,6 +74,11 @@ PathScene assemble_path_scene(const TruthInputs& in, const MajorantGrid& majoran
   for (size_t k = 0; k < in.stars.size(); ++k) {
     stars[k].position = in.stars[k].position;
     for (int b = 0; b < kMaxBands; ++b) stars[k].power[b] = b < int(in.bands.size()) ? in.stars[k].power[size_t(b)] : 0.0f;
+    if (const std::optional<ImagePoint> at = project_point(in.camera, in.stars[k].position)) {
+      stars[k].image_x = static_cast<float>(at->x);
+      stars[k].image_y = static_cast<float>(at->y);
+      stars[k].in_image = true;
+    }
   }
   PathScene s;
   s.density = {in.density->shape, place.place(in.density->tau_v, in.density->device_tau_v)};
@@ -91,6 +98,7 @@ PathScene assemble_path_scene(const TruthInputs& in, const MajorantGrid& majoran
   s.seed = in.seed;
   s.max_orders = in.max_orders;
   s.pixel_side = in.pixel_side;
+  s.star_strata = in.star_strata;
   s.roulette_start = in.roulette_start;
   s.exact_transmittance = in.exact_transmittance;
   s.equiangular = in.equiangular;
