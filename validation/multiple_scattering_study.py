@@ -15,14 +15,13 @@ against truth.
 
 Writes the Markdown page (--out), the rows as JSON beside it, and prints each row.
 """
-import json
 import os
 import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "validation"))
-from nebula_runner import Runner, prepare_work, study_arguments, truth_grid, write_rows  # noqa: E402
+from nebula_runner import Runner, prepare_work, read_rows, study_arguments, truth_grid, write_rows  # noqa: E402
 
 SCENES = ["fig12_reference", "thin_nebula", "thick_nebula", "layer_front", "layer_behind", "wedge", "sphere_tau1",
           "sphere_tau5", "axial_lopsided", "axial_lopsided_thick"]
@@ -131,16 +130,7 @@ def noisy(stderr):
 
 
 def merge(args):
-    rows = []
-    for path in args.merge.split(","):
-        try:
-            with open(path) as f:
-                part = json.load(f)
-        except (OSError, ValueError) as e:
-            raise SystemExit(f"--merge: {path}: cannot read the study's JSON rows ({e})")
-        if not isinstance(part, list) or not all(isinstance(r, dict) and "scene" in r and "method" in r for r in part):
-            raise SystemExit(f"--merge: {path}: not a study's JSON rows (a list of rows with scene and method)")
-        rows += [r for r in part if r["method"] in METHODS]  # methods the study no longer has stay out
+    rows = read_rows(args.merge.split(","), METHODS)  # methods the study no longer has stay out
     for r in rows:  # the per-pixel error, from the images where the work folder holds them
         tag = f"{r['scene']}_a{r['albedo']}_g{r['g']}"
         e = pixel_error(fast_file(args.work, tag, r["method"]), os.path.join(args.work, f"truth_{tag}.h5"))

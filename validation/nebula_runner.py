@@ -87,3 +87,19 @@ def write_rows(rows, out):
     with open(path + ".tmp", "w") as f:
         json.dump(rows, f, indent=1)
     os.replace(path + ".tmp", path)
+
+
+def read_rows(paths, methods):
+    """The rows of a study's JSON files (--merge) whose method is one of `methods`; one line naming the file
+    for a file that cannot be read or holds no study's rows."""
+    rows = []
+    for path in paths:
+        try:
+            with open(path) as f:
+                part = json.load(f)
+        except (OSError, ValueError) as e:
+            raise SystemExit(f"--merge: {path}: cannot read the study's JSON rows ({e})")
+        if not isinstance(part, list) or not all(isinstance(r, dict) and "scene" in r and "method" in r for r in part):
+            raise SystemExit(f"--merge: {path}: not a study's JSON rows (a list of rows with scene and method)")
+        rows += [r for r in part if r["method"] in methods]
+    return rows

@@ -17,7 +17,6 @@ diffuse field baked at each filter's own attenuation), and the albedo's effect.
 
 Writes the Markdown page (--out), the rows as JSON beside it, and prints each row.
 """
-import json
 import os
 import re
 import sys
@@ -25,7 +24,7 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "validation"))
-from nebula_runner import Runner, prepare_work, study_arguments, truth_grid, write_rows  # noqa: E402
+from nebula_runner import Runner, prepare_work, read_rows, study_arguments, truth_grid, write_rows  # noqa: E402
 
 SCENES = ["fig12_reference", "sphere_tau1", "sphere_tau5"]
 FILTERS = {"n450": 450, "n550": 550, "n700": 700}
@@ -95,16 +94,7 @@ def main():
 
 
 def merge(args):
-    rows = []
-    for path in args.merge.split(","):
-        try:
-            with open(path) as f:
-                part = json.load(f)
-        except (OSError, ValueError) as e:
-            raise SystemExit(f"--merge: {path}: cannot read the study's JSON rows ({e})")
-        if not isinstance(part, list) or not all(isinstance(r, dict) and "scene" in r and "method" in r for r in part):
-            raise SystemExit(f"--merge: {path}: not a study's JSON rows (a list of rows with scene and method)")
-        rows += [r for r in part if r["method"] in METHODS]
+    rows = read_rows(args.merge.split(","), METHODS)
     albedos = sorted({r["albedo"] for r in rows})
     gs = sorted({r["g"] for r in rows})
     truths = {(r["scene"], r["albedo"], r["g"]): r["truth_seconds"] for r in rows}
