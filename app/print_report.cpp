@@ -82,7 +82,9 @@ void print_spectral(const RunReport& r) {
   if (s.method == "double") {
     std::printf("  method: double integral, %d wavelength samples per voxel and star\n", s.wavelengths);
   } else if (s.method == "analytic") {
-    std::printf("  method: analytic integral (exponential-integral recurrence) per voxel, star and filter\n");
+    std::printf("  method: analytic integral (Algorithm 1): one set of exponential-integral antiderivatives at each of %d breaks "
+                "(the filters' measured rows) per voxel and star, shared by the filters\n",
+                s.breaks);
   } else if (s.method == "preintegrated") {
     std::printf("  method: pre-integrated, the integral over wavelength tabulated per star and filter over optical "
                 "paths 0-%g (one lookup per voxel, star and filter)\n",

@@ -104,6 +104,7 @@ struct SpectralReport {
   std::string method;             // double, analytic, projection, light_density, voxel_light
   int basis = 0;                  // elements used (the greedy may stop short)
   int wavelengths = 0;            // double: samples
+  int breaks = 0;                 // analytic: the filters' (and stars', continua's) breaks shared by all
   std::string attenuation, norm;  // law or inverse; relative or absolute
   double lo_um = 0, hi_um = 0;    // the wavelength range of the basis and samples
   double fit_depth = 0, max_depth = 0;

@@ -182,6 +182,7 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
   sr.method = scene.spectral->method;
   sr.basis = model.basis.size();
   sr.wavelengths = settings.wavelengths;
+  sr.breaks = int(model.breaks.size());
   sr.attenuation = scene.spectral->attenuation;
   sr.norm = scene.spectral->norm;
   sr.lo_um = model.lo_um;

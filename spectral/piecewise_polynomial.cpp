@@ -6,10 +6,8 @@
 #include "core/error.h"
 
 namespace nebula::spectral {
-namespace {
 
-// The measured curve, linear between rows, zero outside; lambda in um.
-double measured(const Passband& p, double lambda_um) {
+double measured_response(const Passband& p, double lambda_um) {
   const double nm = lambda_um * 1000.0;
   const std::vector<double>& x = p.wavelength_nm;
   if (nm < x.front() || nm > x.back()) return 0.0;
@@ -18,6 +16,8 @@ double measured(const Passband& p, double lambda_um) {
   const double u = (nm - x[i - 1]) / (x[i] - x[i - 1]);
   return (1 - u) * p.response[i - 1] + u * p.response[i];
 }
+
+namespace {
 
 // Solves the 4x4 (or smaller) normal equations by Gaussian elimination with pivoting.
 void solve(int n, double a[4][5]) {
@@ -37,14 +37,13 @@ void solve(int n, double a[4][5]) {
 
 }  // namespace
 
-PiecewisePolynomial fit_function(const std::function<double(double)>& fn, double lo, double hi, int segments) {
+PiecewisePolynomial fit_on_breaks(const std::function<double(double)>& fn, const std::vector<double>& breaks) {
   PiecewisePolynomial out;
   out.degree = kMaxPolynomialDegree;
   const int n = out.degree + 1;
   constexpr int kSamples = 64;
-  for (int s = 0; s <= segments; ++s) out.breaks.push_back(lo + (hi - lo) * s / segments);
-  out.breaks.back() = hi;
-  for (int s = 0; s < segments; ++s) {
+  out.breaks = breaks;
+  for (size_t s = 0; s + 1 < breaks.size(); ++s) {
     const double a = out.breaks[s], b = out.breaks[s + 1], mid = 0.5 * (a + b), half = 0.5 * (b - a);
     // Least squares in t = (lambda - mid) / half on [-1, 1] (well conditioned),
     // then expanded to global powers of lambda.
@@ -75,9 +74,16 @@ PiecewisePolynomial fit_function(const std::function<double(double)>& fn, double
   return out;
 }
 
+PiecewisePolynomial fit_function(const std::function<double(double)>& fn, double lo, double hi, int segments) {
+  std::vector<double> breaks;
+  for (int s = 0; s <= segments; ++s) breaks.push_back(lo + (hi - lo) * s / segments);
+  breaks.back() = hi;
+  return fit_on_breaks(fn, breaks);
+}
+
 namespace {
 PiecewisePolynomial fit_with(const Passband& p, int segments) {
-  return fit_function([&](double l) { return measured(p, l); }, p.wavelength_nm.front() / 1000.0,
+  return fit_function([&](double l) { return measured_response(p, l); }, p.wavelength_nm.front() / 1000.0,
                       p.wavelength_nm.back() / 1000.0, segments);
 }
 }  // namespace
@@ -106,7 +112,7 @@ PiecewisePolynomial fit_passband(const Passband& p, double tolerance, FitReport*
     constexpr int kChecks = 20000;
     for (int k = 0; k <= kChecks; ++k) {
       const double lambda = lo + (hi - lo) * k / kChecks;
-      const double f = fit(lambda), m = measured(p, lambda);
+      const double f = fit(lambda), m = measured_response(p, lambda);
       r.max_error = std::max(r.max_error, std::fabs(f - m) / peak);
       fit_sum += f;
       measured_sum += m;

@@ -38,8 +38,15 @@ struct FitReport {
 PiecewisePolynomial fit_passband(const Passband& passband, double tolerance = 2e-3, FitReport* report = nullptr);
 
 // A least-squares cubic on each of `segments` uniform segments of [lo, hi] um
-// of any function (e.g. a filter times a star's spectrum for Algorithm 1).
+// of any function.
 PiecewisePolynomial fit_function(const std::function<double(double)>& f, double lo_um, double hi_um, int segments);
+// The same on the segments between given breaks (um, ascending): e.g. a
+// filter's measured curve times a star's spectrum on the filter's own rows,
+// where the curve is exactly linear (Algorithm 1, spectral_model.cpp).
+PiecewisePolynomial fit_on_breaks(const std::function<double(double)>& f, const std::vector<double>& breaks);
+
+// The measured curve itself: linear between its rows, zero outside; lambda in um.
+double measured_response(const Passband& passband, double lambda_um);
 
 // The device's view of a piecewise polynomial.
 struct PolynomialView {

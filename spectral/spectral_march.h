@@ -64,6 +64,7 @@ constexpr int kMaxVoxelLightStars = 32;  // VoxelLight: one bit per star in a vo
 constexpr int kMaxTableNodes = 4;        // attenuations at which a pair reads the table
 constexpr int kMaxEmission = 8;          // emission components
 constexpr int kMaxEmissionPlanes = 32;   // emission numbers per ray
+constexpr int kAnalyticTerms = 4;        // Analytic: coefficients of a cubic (piecewise_polynomial.h)
 
 // One emission component in the march (add_emission): its weight per voxel
 // (null: the voxel's tau_V) times scale, and its first plane among the
@@ -96,12 +97,17 @@ struct SpectralSceneView {
   int n_lambda = 0;
   const float* kappa = nullptr;
   const float* q = nullptr;
-  // Analytic: per star and filter a piecewise polynomial P ~ S s (global powers of lambda, um):
-  // the integral is C_T sum_k c_k I_(k-1)(C_T D).
+  // Analytic: per star and filter a piecewise cubic P ~ S s (global powers of lambda, um) on
+  // breaks shared by all (every filter's measured rows, where S is exactly linear, a tabulated
+  // star's, a continuum's ends): the integral of P kappa e^(-kappa D), kappa = C_T / lambda, is
+  // C_T sum_j sum_k jump_jk F_(k-1)(b_j), F the antiderivatives at the break (expint.h) and
+  // jump_jk = c_(j-1)k - c_jk the change of P's coefficients there. One chain of F per break
+  // serves every filter, star, power and segment end.
   double C_T = 0;
-  const double* breaks = nullptr;        // [star][acc][segments + 1]
-  const double* coefficients = nullptr;  // [star][acc][segments][degree + 1]
-  int segments = 0, degree = 0;
+  const double* breaks = nullptr;       // [n_breaks], um ascending
+  const double* jumps = nullptr;        // [star][acc][n_breaks][kAnalyticTerms]
+  const int* break_range = nullptr;     // [acc][2]: the filter's first and last break
+  int n_breaks = 0, break_lo = 0, break_hi = -1;  // the breaks any filter uses
   // Projection / LightBasis: coefficient tables over D (and log T): [t][d][j].
   int n_basis = 0, n_depth = 0, n_temperature = 1;
   float depth_step = 1;
@@ -143,8 +149,7 @@ struct SpectralSceneView {
   int n_emission = 0, n_emission_planes = 0;
   SpectralEmissionView emission[kMaxEmission];
   const float* emission_q = nullptr;               // Double: [component][filter][lambda]
-  const double* emission_breaks = nullptr;         // Analytic: [component][filter][segments + 1]
-  const double* emission_coefficients = nullptr;   // Analytic: [component][filter][segments][degree + 1]
+  const double* emission_jumps = nullptr;          // Analytic: [component][filter][n_breaks][kAnalyticTerms]
   const float* emission_coeff = nullptr;           // basis methods: [d][j]
   // Light scattered between voxels (docs/spectral.md, "Light between voxels"),
   // from the band renderer's diffuse field baked star by star at the nodes'
@@ -323,6 +328,44 @@ NEBULA_HD void for_each_index(int n, F&& f) {
   }
 }
 
+// Algorithm 1 over the shared breaks (SpectralSceneView::breaks): per filter f,
+// sum_t weight[t] integral P_f(lambda) lambda^(offset[t] - 2) e^(-a/lambda) dlambda,
+// P_f the piecewise cubic whose jumps are jumps[f][break][k], passed to emit(f, value).
+// The antiderivatives at each break (expint.h, AntiderivativeWalk: each break's
+// from the previous one's) are made once for all filters and terms; the
+// convention (series or exact) is chosen once for the sum, by a / b at its
+// smallest break.
+template <int kBound, class Emit>
+NEBULA_HD void closed_form(const SpectralSceneView& s, const double* jumps, int n_filters, double a, int n_terms,
+                           const double* weight, const int* offset, Emit&& emit) {
+  int lo = offset[0], hi = offset[0];
+  for (int t = 1; t < n_terms; ++t) {
+    lo = offset[t] < lo ? offset[t] : lo;
+    hi = offset[t] > hi ? offset[t] : hi;
+  }
+  const int m_lo = lo, m_hi = hi + kAnalyticTerms - 1;
+  constexpr int kSums = kBound > 0 ? kBound : kMaxAccumulators;
+  double sum[kSums];
+  for_each_index<kBound>(n_filters, [&](int f) { sum[f] = 0.0; });
+  if (s.break_hi < s.break_lo) return;
+  AntiderivativeWalk walk(a, !(a / s.breaks[s.break_lo] > 1.0), m_lo, m_hi);
+  for (int j = s.break_lo; j <= s.break_hi; ++j) {
+    double F[kMaxAntiderivatives];
+    walk.at(s.breaks[j], F);
+    for_each_index<kBound>(n_filters, [&](int f) {
+      if (j < s.break_range[2 * f] || j > s.break_range[2 * f + 1]) return;
+      const double* J = jumps + (size_t(f) * s.n_breaks + j) * kAnalyticTerms;
+      double v = 0.0;
+      for (int t = 0; t < n_terms; ++t) {
+        const double* G = F + (offset[t] - m_lo);
+        v += weight[t] * (J[0] * G[0] + J[1] * G[1] + J[2] * G[2] + J[3] * G[3]);
+      }
+      sum[f] += v;
+    });
+  }
+  for_each_index<kBound>(n_filters, [&](int f) { emit(f, sum[f]); });
+}
+
 // A ray's accumulators acc(row, col), stored at image plane row * cols + col:
 // the row is the star (Projection) or 0, the column the basis element
 // (Projection, LightBasis) or the filter (Double, Analytic, VoxelLight);
@@ -379,20 +422,11 @@ NEBULA_HD void add_emission(const SpectralSceneView& s, size_t cell, float tau_v
         for (int f = 0; f < s.n_acc; ++f) out[f] += q[f * s.n_lambda + i] * t;
       }
     } else if constexpr (kMethod == SpectralMethod::Analytic) {
-      // integral S_f phi e^(-C_T D / lambda) = sum_k c_k I_k(C_T D), S_f phi piecewise cubic.
-      const double a = s.C_T * double(D);
-      for (int f = 0; f < s.n_acc; ++f) {
-        const size_t cf = size_t(c) * s.n_acc + f;
-        const double* b = s.emission_breaks + cf * (s.segments + 1);
-        const double* k_c = s.emission_coefficients + cf * s.segments * (s.degree + 1);
-        double sum = 0.0;
-        for (int seg = 0; seg < s.segments; ++seg)
-          for (int k = 0; k <= s.degree; ++k) {
-            const double ck = k_c[seg * (s.degree + 1) + k];
-            if (ck != 0.0) sum += ck * power_exp_integral(k, a, b[seg], b[seg + 1]);
-          }
-        out[f] += w * float(sum);
-      }
+      // integral S_f phi e^(-C_T D / lambda), S_f phi piecewise cubic: powers k = 0..3 (m = k + 2).
+      const double weight[1] = {1.0};
+      const int offset[1] = {2};
+      closed_form<0>(s, s.emission_jumps + size_t(c) * s.n_acc * s.n_breaks * kAnalyticTerms, s.n_acc,
+                     s.C_T * double(D), 1, weight, offset, [&](int f, double v) { out[f] += w * float(v); });
     } else {
       int d0;
       float fd;
@@ -455,23 +489,16 @@ NEBULA_HD void add_pair(const SpectralSceneView& s, int star, const PairWeights&
           shift *= -double(s.kappa_center);
         }
       }
-      const double a = s.C_T * double(D);
-      for_each_index<Acc::kCols>(s.n_acc, [&](int f) {
-        const size_t pf = size_t(star) * s.n_acc + f;
-        const double* b = s.breaks + pf * (s.segments + 1);
-        const double* c = s.coefficients + pf * s.segments * (s.degree + 1);
-        double total = 0.0, C_T_power = s.C_T;
-        for (int p = 0; p < w.n; ++p, C_T_power *= s.C_T) {
-          double sum = 0.0;
-          for (int seg = 0; seg < s.segments; ++seg)
-            for (int k = 0; k <= s.degree; ++k) {
-              const double ck = c[seg * (s.degree + 1) + k];
-              if (ck != 0.0) sum += ck * power_exp_integral(k - 1 - p, a, b[seg], b[seg + 1]);
-            }
-          total += mono[p] * C_T_power * sum;
-        }
-        acc(0, f) += float(total);
-      });
+      // The power p of kappa = C_T / lambda times P's lambda^k: lambda^(k-1-p), m = k + 1 - p.
+      double weight[kMaxTableNodes] = {};
+      int offset[kMaxTableNodes] = {};
+      double C_T_power = s.C_T;
+      for (int p = 0; p < w.n; ++p, C_T_power *= s.C_T) {
+        weight[p] = mono[p] * C_T_power;
+        offset[p] = 1 - p;
+      }
+      closed_form<Acc::kCols>(s, s.jumps + size_t(star) * s.n_acc * s.n_breaks * kAnalyticTerms, s.n_acc,
+                              s.C_T * double(D), w.n, weight, offset, [&](int f, double v) { acc(0, f) += float(v); });
       break;
     }
     case SpectralMethod::VoxelLight:

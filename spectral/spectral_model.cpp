@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include <Eigen/Dense>
 
@@ -150,6 +151,61 @@ double SpectralModel::wavelength_of_kappa(double kappa) const {
   return grid.lambda[best];
 }
 
+namespace {
+
+// Analytic: the breaks every filter, tabulated star and continuum shares: each
+// filter's measured rows (its curve is linear between them, so a cubic per
+// segment times a smooth spectrum is within ~(h/lambda)^4 of the product), a
+// tabulated star's rows and a continuum's ends within the filters' span; and
+// each filter's first and last break.
+void set_analytic_breaks(SpectralModel& m) {
+  std::vector<double> b;
+  for (const Passband& p : m.measured)
+    for (double nm : p.wavelength_nm) b.push_back(nm / 1000.0);
+  const double lo = b.empty() ? 0.0 : *std::min_element(b.begin(), b.end());
+  const double hi = b.empty() ? 0.0 : *std::max_element(b.begin(), b.end());
+  for (const SpectralStar& star : m.stars)
+    if (star.table)
+      for (double l : star.table->wavelength_um)
+        if (l > lo && l < hi) b.push_back(l);
+  for (const SpectralEmission& e : m.emission)
+    for (double l : {e.lo_um, e.hi_um})
+      if (e.line_um <= 0 && l > lo && l < hi) b.push_back(l);
+  std::sort(b.begin(), b.end());
+  m.breaks.clear();
+  for (double l : b)
+    if (m.breaks.empty() || l > m.breaks.back() * (1 + 1e-12)) m.breaks.push_back(l);
+  m.break_range.clear();
+  for (const Passband& p : m.measured) {
+    const auto at = [&](double nm) {
+      const double l = nm / 1000.0;
+      return int(std::lower_bound(m.breaks.begin(), m.breaks.end(), l * (1 - 1e-12)) - m.breaks.begin());
+    };
+    m.break_range.push_back(at(p.wavelength_nm.front()));
+    m.break_range.push_back(at(p.wavelength_nm.back()));
+  }
+  m.jumps.clear();
+}
+
+// Appends filter f's jumps for fn (zero outside the filter's rows): a least-squares
+// cubic on each segment of the shared breaks within them (global powers of lambda),
+// and at break j the change c_(j-1) - c_j (c zero beyond the filter's ends).
+static_assert(kAnalyticTerms == kMaxPolynomialDegree + 1);
+void append_jumps(const SpectralModel& m, int f, const std::function<double(double)>& fn, std::vector<double>& out) {
+  const int n = int(m.breaks.size()), j0 = m.break_range[2 * size_t(f)], j1 = m.break_range[2 * size_t(f) + 1];
+  const std::vector<double> own(m.breaks.begin() + j0, m.breaks.begin() + j1 + 1);
+  const PiecewisePolynomial p = fit_on_breaks(fn, own);
+  const size_t base = out.size();
+  out.resize(base + size_t(n) * kAnalyticTerms, 0.0);
+  const auto c = [&](int seg, int k) {  // segment seg of the shared breaks
+    return seg < j0 || seg >= j1 ? 0.0 : p.coefficients[size_t(seg - j0) * kAnalyticTerms + k];
+  };
+  for (int j = j0; j <= j1; ++j)
+    for (int k = 0; k < kAnalyticTerms; ++k) out[base + size_t(j) * kAnalyticTerms + k] = c(j - 1, k) - c(j, k);
+}
+
+}  // namespace
+
 SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Passband>>& filters,
                                    const std::vector<SpectralStar>& stars, const SpectralSettings& settings,
                                    const std::vector<SpectralEmission>& emission) {
@@ -203,6 +259,7 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
     m.filter_names.push_back(name);
     m.filters.push_back(fit_passband(band, 2e-3, &r));
     m.fits.push_back(r);
+    m.measured.push_back(band);
     m.lo_um = std::min(m.lo_um, band.wavelength_nm.front() / 1000.0);
     m.hi_um = std::max(m.hi_um, band.wavelength_nm.back() / 1000.0);
   }
@@ -269,14 +326,11 @@ SpectralModel build_spectral_model(const std::vector<std::pair<std::string, Pass
     case SpectralMethod::Analytic: {
       if (F > kMaxAccumulators) throw Error("spectral: at most 64 filters");
       m.n_acc = F;
-      for (const FitReport& r : m.fits) m.segments = std::max(m.segments, r.segments);
+      set_analytic_breaks(m);
       for (int s = 0; s < S; ++s)
         for (int f = 0; f < F; ++f) {
-          const PiecewisePolynomial& filter = m.filters[f];
-          const PiecewisePolynomial p = fit_function([&](double l) { return filter(l) * stars[s].shape(l); },
-                                                     filter.breaks.front(), filter.breaks.back(), m.segments);
-          m.breaks.insert(m.breaks.end(), p.breaks.begin(), p.breaks.end());
-          m.coefficients.insert(m.coefficients.end(), p.coefficients.begin(), p.coefficients.end());
+          const Passband& curve = m.measured[size_t(f)];
+          append_jumps(m, f, [&](double l) { return measured_response(curve, l) * stars[s].shape(l); }, m.jumps);
         }
       break;
     }
@@ -395,8 +449,7 @@ void build_emission(SpectralModel& m) {
                 (per_filter ? "1 per filter" : "1 per basis element") + "); at most " +
                 std::to_string(kMaxEmissionPlanes));
   m.emission_q.clear();
-  m.emission_breaks.clear();
-  m.emission_coefficients.clear();
+  m.emission_jumps.clear();
   m.emission_coeff.clear();
   if (m.emission.empty()) return;
   if (method == SpectralMethod::Double) {
@@ -409,21 +462,13 @@ void build_emission(SpectralModel& m) {
           m.emission_q.push_back(float(m.filters[f](l) * e.phi(l) * step));
         }
   } else if (method == SpectralMethod::Analytic) {
-    // S_f phi as piecewise cubics (global powers of lambda) on the overlap of the
-    // filter and the continuum's range; a line (or no overlap): zeros.
-    const int segments = m.segments, coefficients = segments * (kMaxPolynomialDegree + 1);
+    // S_f phi as piecewise cubics on the shared breaks (a continuum's ends among them); a line: zeros.
     for (const SpectralEmission& e : m.emission)
       for (int f = 0; f < F; ++f) {
-        const PiecewisePolynomial& filter = m.filters[f];
-        const double lo = std::max(filter.breaks.front(), e.lo_um), hi = std::min(filter.breaks.back(), e.hi_um);
-        if (e.line_um > 0 || !(lo < hi)) {
-          m.emission_breaks.insert(m.emission_breaks.end(), segments + 1, filter.breaks.front());
-          m.emission_coefficients.insert(m.emission_coefficients.end(), coefficients, 0.0);
-          continue;
-        }
-        const PiecewisePolynomial p = fit_function([&](double l) { return filter(l) * e.phi(l); }, lo, hi, segments);
-        m.emission_breaks.insert(m.emission_breaks.end(), p.breaks.begin(), p.breaks.end());
-        m.emission_coefficients.insert(m.emission_coefficients.end(), p.coefficients.begin(), p.coefficients.end());
+        const Passband& curve = m.measured[size_t(f)];
+        append_jumps(
+            m, f, [&](double l) { return e.line_um > 0 ? 0.0 : measured_response(curve, l) * e.phi(l); },
+            m.emission_jumps);
       }
   } else if (method == SpectralMethod::Preintegrated) {
     // integral S_f phi e^(-kappa D) per component, depth and filter (zeros for a line).
@@ -539,6 +584,7 @@ void set_filters(SpectralModel& m, const std::vector<std::pair<std::string, Pass
   m.filter_names.clear();
   m.filters.clear();
   m.fits.clear();
+  m.measured.clear();
   for (const auto& [name, band] : filters) {
     const double lo = band.wavelength_nm.front() / 1000.0, hi = band.wavelength_nm.back() / 1000.0;
     if (lo < m.lo_um - 1e-12 || hi > m.hi_um + 1e-12)
@@ -548,6 +594,7 @@ void set_filters(SpectralModel& m, const std::vector<std::pair<std::string, Pass
     m.filter_names.push_back(name);
     m.filters.push_back(fit_passband(band, 2e-3, &r));
     m.fits.push_back(r);
+    m.measured.push_back(band);
   }
   if (voxel || pre) {
     if (pre) build_emission(m);  // its continua's tables hold the filters
@@ -582,9 +629,17 @@ SpectralSceneView view_of(const SpectralModel& m) {
   v.q = m.q.data();
   v.C_T = m.C_T;
   v.breaks = m.breaks.data();
-  v.coefficients = m.coefficients.data();
-  v.segments = m.segments;
-  v.degree = kMaxPolynomialDegree;
+  v.jumps = m.jumps.data();
+  v.break_range = m.break_range.data();
+  v.n_breaks = int(m.breaks.size());
+  if (!m.break_range.empty()) {
+    v.break_lo = v.n_breaks;
+    v.break_hi = -1;
+    for (size_t f = 0; f + 1 < m.break_range.size(); f += 2) {
+      v.break_lo = std::min(v.break_lo, m.break_range[f]);
+      v.break_hi = std::max(v.break_hi, m.break_range[f + 1]);
+    }
+  }
   v.n_basis = m.basis.size();
   v.n_depth = m.settings.depth_nodes;
   v.n_temperature = m.n_temperature;
@@ -614,8 +669,7 @@ SpectralSceneView view_of(const SpectralModel& m) {
     e.line_kappa = e.line ? float(m.kappa_at(m.emission[size_t(c)].line_um)) : 0.0f;
   }
   v.emission_q = m.emission_q.data();
-  v.emission_breaks = m.emission_breaks.data();
-  v.emission_coefficients = m.emission_coefficients.data();
+  v.emission_jumps = m.emission_jumps.data();
   v.emission_coeff = m.emission_coeff.empty() ? m.coeff.data() : m.emission_coeff.data();
   return v;  // n_nodes stays 0 (the thin limit) until the renderer is given a table
 }

@@ -96,6 +96,7 @@ struct SpectralModel {
   SpectralSettings settings;
   std::vector<std::string> filter_names;
   std::vector<PiecewisePolynomial> filters;  // fitted S_f
+  std::vector<Passband> measured;            // the curves as given (Analytic: exact, linear between rows)
   std::vector<FitReport> fits;
   double lo_um = 0, hi_um = 0;  // the filters' span
   double C_T = 0;               // kappa = C_T / lambda (Inverse)
@@ -112,8 +113,11 @@ struct SpectralModel {
   int n_acc = 0;
   std::vector<float> kappa, q, coeff, temperature_u;
   std::vector<float> star_coeff;  // VoxelLight: [star][depth][filter][basis] (spectral_march.h)
-  std::vector<double> breaks, coefficients;
-  int segments = 0;
+  // Analytic (Algorithm 1; SpectralSceneView): the breaks shared by every
+  // filter, star and continuum, the jumps of each piecewise cubic at them, and
+  // each filter's first and last break.
+  std::vector<double> breaks, jumps;
+  std::vector<int> break_range;
   float depth_step = 1;
   int n_temperature = 1;
   float max_eye_depth = 1e30f;
@@ -139,7 +143,7 @@ struct SpectralModel {
   int n_emission_planes = 0;
   std::vector<int> emission_plane;     // per component: its first plane (after the star planes)
   std::vector<float> emission_q;       // Double: [component][filter][lambda] S_f phi dlambda
-  std::vector<double> emission_breaks, emission_coefficients;  // Analytic: S_f phi per [component][filter]
+  std::vector<double> emission_jumps;  // Analytic: S_f phi's jumps, [component][filter][break][degree + 1]
   std::vector<float> emission_coeff;   // LightBasis: e^(-kappa D) on the basis, [d][j] (else coeff's first block)
   int planes() const { return n_acc + n_emission_planes; }
   double kappa_at(double lambda_um) const;

@@ -138,9 +138,7 @@ void with_accumulators(const SpectralSceneView& v, Launch&& launch) {
       case 8: by_cols(Int<1>(), Int<8>()); break;
       default: launch(DynamicAccumulators()); break;
     }
-  } else if constexpr (kMethod == SpectralMethod::Analytic) {  // far from register-bound: one kernel
-    launch(DynamicAccumulators());
-  } else {  // Double (filters), LightBasis (basis) in the columns
+  } else {  // Double, Analytic (filters), LightBasis (basis) in the columns
     by_cols(Int<1>(), Int<kBasisInColumns>());
   }
 }
@@ -158,6 +156,7 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
   const SpectralModel& m = *in.model;
   std::vector<std::unique_ptr<DeviceArray<float>>> floats;
   std::vector<std::unique_ptr<DeviceArray<double>>> doubles;
+  std::vector<std::unique_ptr<DeviceArray<int>>> ints;
   std::vector<std::unique_ptr<DeviceArray<SpectralStarView>>> star_arrays;
   SpectralSceneView view = view_of(m);
   view.density = {in.density->shape, upload(floats, in.density->tau_v)};
@@ -211,11 +210,11 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
   view.q = upload(floats, m.q);
   view.coeff = upload(floats, m.coeff);
   view.breaks = upload(doubles, m.breaks);
-  view.coefficients = upload(doubles, m.coefficients);
+  view.jumps = upload(doubles, m.jumps);
+  view.break_range = upload(ints, m.break_range);
   view.star_coeff = upload(floats, m.star_coeff);
   view.emission_q = upload(floats, m.emission_q);
-  view.emission_breaks = upload(doubles, m.emission_breaks);
-  view.emission_coefficients = upload(doubles, m.emission_coefficients);
+  view.emission_jumps = upload(doubles, m.emission_jumps);
   view.emission_coeff = m.emission_coeff.empty() ? view.coeff : upload(floats, m.emission_coeff);
   std::vector<const float*> grids;
   for (const SpectralEmissionWeight& e : in.emission) grids.push_back(e.grid ? upload(floats, *e.grid) : nullptr);
