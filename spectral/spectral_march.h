@@ -172,6 +172,13 @@ struct SpectralSceneView {
   float node_albedo[kMaxTableNodes] = {}, node_g[kMaxTableNodes] = {};
   const float* node_P[kMaxTableNodes] = {};
   const float* node_C[kMaxTableNodes] = {};  // their cumulative rows (TableView::C; null: the midpoint only)
+  // Every node's table value at once (node_table_values): node_table[(row * n_mu + bin) * 4 + m] =
+  // node m's lookup at its scattering depth for tau_V = row * node_table_step, at the bin's
+  // centre; one bilinear read of 16-byte cells for all nodes instead of one lookup per node.
+  // Null: a lookup per node (and always for a chord's mean near a star).
+  const float* node_table = nullptr;
+  int node_table_rows = 0;
+  float node_table_step = 1;
   // Rays within this distance of a star take the phase's mean over their chords' angles
   // (march_spectral<kMethod, true>; tables/chord_phase.h); 0: none (the thin limit, uniform-mu tables).
   float near_star_radius = 0.0f;
@@ -194,6 +201,39 @@ NEBULA_HD bool depth_row(const SpectralSceneView& s, float D, int& d0, float& fd
 NEBULA_HD float hg_phase(float mu, float g) {
   const float d = 1.0f + g * g - 2.0f * g * mu;
   return (1.0f - g * g) * kInv4Pi / (d * sqrtf(d));
+}
+
+// Every node's table value for a voxel of V-band depth tau_v at the table's
+// angle coordinate u, from SpectralSceneView::node_table: bilinear in (tau_v,
+// u) between its rows and bin centres, as TableView::lookup_at is in (tau_sct,
+// u); the rows are at most the table's own row spacing apart at every node's
+// scattering depth (node_table_values's host side, spectral_renderer.cpp), so
+// the two differ by the table's own interpolation error. Beyond the last row
+// every node is at the table's end, as its own lookup clamps there.
+struct alignas(16) NodeCell {
+  float v[4];
+};
+NEBULA_HD void node_table_values(const SpectralSceneView& s, float tau_v, float u, float* out) {
+  const int n_mu = s.table.n_mu;
+  float x = tau_v / s.node_table_step;
+  x = x >= 0.0f ? fminf(x, float(s.node_table_rows - 1)) : 0.0f;  // NaN and negative: row 0
+  int i = int(x);
+  if (i > s.node_table_rows - 2) i = s.node_table_rows - 2;
+  const float ft = x - float(i);
+  float y = u < 0.0f ? 0.0f : fminf(u, float(n_mu - 1));
+  int k = int(y);
+  if (k > n_mu - 2) k = n_mu - 2 > 0 ? n_mu - 2 : 0;
+  const float fu = n_mu > 1 ? y - float(k) : 0.0f;
+  const int k1 = k + 1 < n_mu ? k + 1 : k;
+  const NodeCell* cells = reinterpret_cast<const NodeCell*>(s.node_table);
+  const NodeCell a = cells[size_t(i) * n_mu + k], b = cells[size_t(i) * n_mu + k1];
+  const NodeCell c = cells[size_t(i + 1) * n_mu + k], d = cells[size_t(i + 1) * n_mu + k1];
+  NEBULA_UNROLL
+  for (int m = 0; m < 4; ++m) {
+    const float v0 = (1.0f - fu) * a.v[m] + fu * b.v[m];
+    const float v1 = (1.0f - fu) * c.v[m] + fu * d.v[m];
+    out[m] = (1.0f - ft) * v0 + ft * v1;
+  }
 }
 
 // One voxel-star pair's weights on the powers of kappa - kappa_c: its light through
@@ -235,6 +275,12 @@ NEBULA_HD PairWeights pair_weights(const SpectralSceneView& s, float w, float ta
     p.a1 = at->a1;
   }
   float node[kMaxTableNodes];
+  if (s.node_table && !p.mean) {
+    float P[4];
+    node_table_values(s, tau_v, p.u, P);
+    NEBULA_UNROLL
+    for (int m = 0; m < kMaxTableNodes; ++m) node[m] = p.scale * P[m] / s.node_kappa[m];
+  } else {
   NEBULA_UNROLL
   for (int m = 0; m < kMaxTableNodes; ++m) {
     if (m >= s.n_nodes) break;
@@ -249,6 +295,7 @@ NEBULA_HD PairWeights pair_weights(const SpectralSceneView& s, float w, float ta
                     : p.mean ? chord_phase_mean(t, tau_sct, p.a0, p.a1, nullptr)
                              : t.lookup_at(tau_sct, p.u);
     node[m] = p.scale * P / s.node_kappa[m];
+  }
   }
   NEBULA_UNROLL
   for (int q = 0; q < kMaxTableNodes; ++q) {

@@ -96,6 +96,40 @@ void set_table(SpectralSceneView& view, const SpectralRenderInputs& in, const fl
     view.near_star_radius = chord_phase_radius(std::sqrt(3.0f) * in.density->shape.voxel, view.table.n_mu);
 }
 
+NodeTable node_table(const SpectralRenderInputs& in, const SpectralSceneView& view) {
+  static_assert(kMaxTableNodes == 4, "a node cell holds four values");
+  NodeTable out;
+  const int n = view.n_nodes;
+  const bool varying = in.model->varying();
+  if (n < 1 || (varying ? in.node_tables.size() != size_t(n) : !in.table)) return out;
+  std::vector<TableView> tables;
+  float c[kMaxTableNodes], c_min = 1e30f, c_max = 0.0f;  // node m's scattering depth per unit tau_V
+  for (int m = 0; m < n; ++m) {
+    tables.push_back(nebula::view_of(varying ? *in.node_tables[size_t(m)] : *in.table));
+    c[m] = (varying ? view.node_albedo[m] : in.albedo) * view.node_kappa[m];
+    c_min = std::min(c_min, c[m]);
+    c_max = std::max(c_max, c[m]);
+  }
+  const TableView& t = tables[0];
+  if (!(c_min > 0.0f) || t.n_tau < 2 || t.n_mu < 1) return out;
+  // Rows half the table's spacing apart at the deepest node: the nodes' values are the
+  // table's piecewise-linear lookups, whose kinks at its rows (its Monte-Carlo noise among
+  // them) a linear interpolant over a row of length d smooths by up to |slope jump| d / 4.
+  constexpr double kRowsPerTableRow = 2;
+  const double spacing = double(t.tau_max) / (t.n_tau - 1), step = spacing / c_max / kRowsPerTableRow;
+  const double rows = std::ceil(double(t.tau_max) / (double(c_min) * step)) + 1;  // until every node clamps
+  if (rows > 65536) return out;
+  out.rows = int(rows);
+  out.step = float(step);
+  out.values.assign(size_t(out.rows) * t.n_mu * 4, 0.0f);
+  tbb::parallel_for(0, out.rows, [&](int i) {
+    for (int k = 0; k < t.n_mu; ++k)
+      for (int m = 0; m < n; ++m)
+        out.values[(size_t(i) * t.n_mu + k) * 4 + m] = tables[size_t(m)].lookup_at(c[m] * float(i * step), float(k));
+  });
+  return out;
+}
+
 void set_emission(SpectralSceneView& view, const SpectralRenderInputs& in, const std::vector<const float*>& grids) {
   for (size_t c = 0; c < in.emission.size(); ++c) {
     view.emission[c].weight = grids[c];
@@ -170,6 +204,12 @@ Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds) {
   }
   const std::vector<float> C = in.table ? cumulative_rows(*in.table) : std::vector<float>{};
   set_table(view, in, in.table ? in.table->P.data() : nullptr, C.empty() ? nullptr : C.data(), node_P, node_C);
+  const NodeTable nodes = node_table(in, view);
+  if (!nodes.values.empty()) {
+    view.node_table = nodes.values.data();
+    view.node_table_rows = nodes.rows;
+    view.node_table_step = nodes.step;
+  }
   const auto start = std::chrono::steady_clock::now();  // the per-view work is timed with the march
   const DiffuseTerms diffuse = diffuse_terms(in, view);
   if (in.diffuse) {

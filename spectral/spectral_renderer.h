@@ -104,4 +104,15 @@ void set_emission(SpectralSceneView& view, const SpectralRenderInputs& in, const
 void set_table(SpectralSceneView& view, const SpectralRenderInputs& in, const float* P, const float* C,
                const std::vector<const float*>& node_P = {}, const std::vector<const float*>& node_C = {});
 
+// SpectralSceneView::node_table for these inputs and the view's nodes (set_table
+// first), built on the host from the tables: every node's value at rows of
+// V-band depth and the table's bin centres; empty where the nodes read their own
+// lookups (the thin limit, a node without a table, a zero albedo).
+struct NodeTable {
+  std::vector<float> values;  // [row][bin][4]
+  int rows = 0;
+  float step = 1;
+};
+NodeTable node_table(const SpectralRenderInputs& in, const SpectralSceneView& view);
+
 }  // namespace nebula::spectral
