@@ -275,12 +275,9 @@ NEBULA_HD PairWeights pair_weights(const SpectralSceneView& s, float w, float ta
     p.a1 = at->a1;
   }
   float node[kMaxTableNodes];
-  if (s.node_table && !p.mean) {
-    float P[4];
-    node_table_values(s, tau_v, p.u, P);
-    NEBULA_UNROLL
-    for (int m = 0; m < kMaxTableNodes; ++m) node[m] = p.scale * P[m] / s.node_kappa[m];
-  } else {
+  float fused[kMaxTableNodes];  // every node's value in one read (node_table), where it applies
+  const bool one_read = s.node_table && !p.mean;
+  if (one_read) node_table_values(s, tau_v, p.u, fused);
   NEBULA_UNROLL
   for (int m = 0; m < kMaxTableNodes; ++m) {
     if (m >= s.n_nodes) break;
@@ -291,11 +288,11 @@ NEBULA_HD PairWeights pair_weights(const SpectralSceneView& s, float w, float ta
       t.P = s.node_P[m];
       t.C = s.node_C[m];
     }
-    const float P = !t.P    ? tau_sct * hg_phase(mu, s.node_g[m])
+    const float P = one_read ? fused[m]
+                    : !t.P   ? tau_sct * hg_phase(mu, s.node_g[m])
                     : p.mean ? chord_phase_mean(t, tau_sct, p.a0, p.a1, nullptr)
                              : t.lookup_at(tau_sct, p.u);
     node[m] = p.scale * P / s.node_kappa[m];
-  }
   }
   NEBULA_UNROLL
   for (int q = 0; q < kMaxTableNodes; ++q) {
