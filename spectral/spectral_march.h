@@ -110,7 +110,7 @@ struct SpectralSceneView {
   int n_breaks = 0, break_lo = 0, break_hi = -1;  // the breaks any filter uses
   // Projection / LightBasis: coefficient tables over D (and log T): [t][d][j].
   int n_basis = 0, n_depth = 0, n_temperature = 1;
-  float depth_step = 1;
+  float depth_step = 1, inv_depth_step = 1;  // a depth's row is D * inv_depth_step: no division per pair
   const float* coeff = nullptr;
   // Preintegrated (n_acc = filters F): star_coeff[star][p][d][f] = the integral over
   // lambda of S_f kappa (kappa - kappa_c)^p s e^(-kappa D_d) (VoxelLight's Q with the
@@ -139,6 +139,8 @@ struct SpectralSceneView {
   float kappa_center = 0;  // the powers are of kappa - kappa_center (SpectralModel)
   float node_kappa[kMaxTableNodes] = {};
   float node_to_power[kMaxTableNodes * kMaxTableNodes] = {};
+  // node_to_power[q][m] / node_kappa[m]: B_q = sum_m node_weight[q][m] P_m, with no division per pair.
+  float node_weight[kMaxTableNodes * kMaxTableNodes] = {};
   // Emission (docs/spectral.md, "Emission"): a voxel adds w(x) phi(lambda) seen
   // through e^(-kappa D_eye), D_eye the V-band depth from the eye to its entry.
   // A line's plane gathers w e^(-kappa_l D) (exact; resolved with S_f(lambda_l));
@@ -173,12 +175,12 @@ struct SpectralSceneView {
   const float* node_P[kMaxTableNodes] = {};
   const float* node_C[kMaxTableNodes] = {};  // their cumulative rows (TableView::C; null: the midpoint only)
   // Every node's table value at once (node_table_values): node_table[(row * n_mu + bin) * 4 + m] =
-  // node m's lookup at its scattering depth for tau_V = row * node_table_step, at the bin's
+  // node m's lookup at its scattering depth for tau_V = row / node_table_inv_step, at the bin's
   // centre; one bilinear read of 16-byte cells for all nodes instead of one lookup per node.
-  // Null: a lookup per node (and always for a chord's mean near a star).
+  // Null: a lookup per node (and always for a chord's mean near a star). use_node_table sets them.
   const float* node_table = nullptr;
   int node_table_rows = 0;
-  float node_table_step = 1;
+  float node_table_inv_step = 1;  // rows per unit of tau_V
   // Rays within this distance of a star take the phase's mean over their chords' angles
   // (march_spectral<kMethod, true>; tables/chord_phase.h); 0: none (the thin limit, uniform-mu tables).
   float near_star_radius = 0.0f;
@@ -190,17 +192,29 @@ struct SpectralSceneView {
 // row d0 below it and the fraction fd to the next; false beyond the last row,
 // where the light is below the transmittance cut.
 NEBULA_HD bool depth_row(const SpectralSceneView& s, float D, int& d0, float& fd) {
-  const float x = D / s.depth_step;
+  const float x = D * s.inv_depth_step;
   if (!(x < float(s.n_depth - 1))) return false;
   d0 = int(x);
   fd = x - float(d0);
   return true;
 }
 
-// Henyey-Greenstein phase function per steradian.
+// 1 / sqrt(x): the GPU's reciprocal square root (within 2 ulp), the CPU's
+// quotient; for the march's per-pair arithmetic (no division there).
+NEBULA_HD float reciprocal_sqrt(float x) {
+#ifdef __CUDA_ARCH__
+  return rsqrtf(x);
+#else
+  return 1.0f / sqrtf(x);
+#endif
+}
+
+// Henyey-Greenstein phase function per steradian: (1 - g^2) / (4 pi) d^(-3/2),
+// d = 1 + g^2 - 2 g mu, by one reciprocal square root (per pair on the march).
 NEBULA_HD float hg_phase(float mu, float g) {
   const float d = 1.0f + g * g - 2.0f * g * mu;
-  return (1.0f - g * g) * kInv4Pi / (d * sqrtf(d));
+  const float r = reciprocal_sqrt(d);
+  return (1.0f - g * g) * kInv4Pi * (r * r * r);
 }
 
 // Every node's table value for a voxel of V-band depth tau_v at the table's
@@ -215,7 +229,7 @@ struct alignas(16) NodeCell {
 };
 NEBULA_HD void node_table_values(const SpectralSceneView& s, float tau_v, float u, float* out) {
   const int n_mu = s.table.n_mu;
-  float x = tau_v / s.node_table_step;
+  float x = tau_v * s.node_table_inv_step;
   x = x >= 0.0f ? fminf(x, float(s.node_table_rows - 1)) : 0.0f;  // NaN and negative: row 0
   int i = int(x);
   if (i > s.node_table_rows - 2) i = s.node_table_rows - 2;
@@ -237,14 +251,15 @@ NEBULA_HD void node_table_values(const SpectralSceneView& s, float tau_v, float 
 }
 
 // One voxel-star pair's weights on the powers of kappa - kappa_c: its light through
-// filter f is sum_p b[p] integral S_f kappa (kappa - kappa_c)^p s e^(-kappa D) dlambda. w is
-// the thin-limit weight L/(4 pi) <1/r^2> a tau_V p_HG(mu) c/l: alone (b[0] = w)
-// without a table; with one, scale = w / (a tau_V p_HG) turns P(tau_sct, u) into
-// the pair's weight at an attenuation (Double's exact lookups use it too).
+// filter f is sum_p b[p] integral S_f kappa (kappa - kappa_c)^p s e^(-kappa D) dlambda.
+// The pair's light geometry is `light` = L/(4 pi) <1/r^2> c/l; its thin-limit
+// weight w = light a tau_V p_HG(mu) (b[0] = w without a table); with one, P(tau_sct, u)
+// times scale = light is the pair's weight at an attenuation (Double's exact lookups use
+// it too).
 struct PairWeights {
   float b[kMaxTableNodes];
   int n;
-  float scale, tau_sct, u;  // tables: w / (a tau_V p_HG), a tau_V, the table's angle coordinate
+  float scale, tau_sct, u;  // tables: light (= w / (a tau_V p_HG)), a tau_V, the table's angle coordinate
   float tau_v, mu;          // varying albedo and g: the double integral's thin limit per wavelength
   float a0, a1;             // mean: P is averaged over the chord's angles a in [a0, a1] (chord_phase_mean)
   bool mean;
@@ -253,34 +268,34 @@ struct PairWeights {
 // voxel-light pre-pass' centre): a chord seeing the star over enough of a
 // uniform-theta table's bins takes the table's mean over them, as the band
 // marcher does (tables/chord_phase.h); the thin limit keeps the midpoint.
-NEBULA_HD PairWeights pair_weights(const SpectralSceneView& s, float w, float tau_v, float mu,
-                                   const ChordIrradiance* at = nullptr) {
+// No division here: the march runs this per voxel and star.
+NEBULA_HD PairWeights pair_weights_of_light(const SpectralSceneView& s, float light, float tau_v, float mu,
+                                            const ChordIrradiance* at = nullptr) {
   PairWeights p;
-  p.b[0] = w;
+  p.tau_sct = s.albedo * tau_v;
+  p.b[0] = light * p.tau_sct * hg_phase(mu, s.g);
   p.n = 1;
   p.scale = 0.0f;
-  p.tau_sct = s.albedo * tau_v;
   p.u = 0.0f;
   p.tau_v = tau_v;
   p.mu = mu;
   p.a0 = p.a1 = 0.0f;
   p.mean = false;
   if (s.n_nodes == 0) return p;
-  const float thin = p.tau_sct * hg_phase(mu, s.g);
-  p.scale = thin > 0.0f ? w / thin : 0.0f;
+  if (!(p.tau_sct > 0.0f)) light = 0.0f;  // no scattering: every weight 0
+  p.scale = light;
   p.u = s.table.angle_coordinate(mu);
   if (at && s.table.n_mu > 0 && s.table.C && chord_takes_phase_mean(s.table, at->a0, at->a1)) {
     p.mean = true;
     p.a0 = at->a0;
     p.a1 = at->a1;
   }
-  float node[kMaxTableNodes];
-  float fused[kMaxTableNodes];  // every node's value in one read (node_table), where it applies
-  const bool one_read = s.node_table && !p.mean;
-  if (one_read) node_table_values(s, tau_v, p.u, fused);
+  float node[kMaxTableNodes];  // each node's P
+  const bool one_read = s.node_table && !p.mean;  // every node's value in one read (node_table)
+  if (one_read) node_table_values(s, tau_v, p.u, node);
   NEBULA_UNROLL
   for (int m = 0; m < kMaxTableNodes; ++m) {
-    if (m >= s.n_nodes) break;
+    if (m >= s.n_nodes || one_read) break;
     TableView t = s.table;
     float tau_sct = p.tau_sct * s.node_kappa[m];
     if (s.varying) {  // the node's own albedo, g and table (or the thin limit)
@@ -288,11 +303,9 @@ NEBULA_HD PairWeights pair_weights(const SpectralSceneView& s, float w, float ta
       t.P = s.node_P[m];
       t.C = s.node_C[m];
     }
-    const float P = one_read ? fused[m]
-                    : !t.P   ? tau_sct * hg_phase(mu, s.node_g[m])
-                    : p.mean ? chord_phase_mean(t, tau_sct, p.a0, p.a1, nullptr)
-                             : t.lookup_at(tau_sct, p.u);
-    node[m] = p.scale * P / s.node_kappa[m];
+    node[m] = !t.P   ? tau_sct * hg_phase(mu, s.node_g[m])
+              : p.mean ? chord_phase_mean(t, tau_sct, p.a0, p.a1, nullptr)
+                       : t.lookup_at(tau_sct, p.u);
   }
   NEBULA_UNROLL
   for (int q = 0; q < kMaxTableNodes; ++q) {
@@ -300,11 +313,23 @@ NEBULA_HD PairWeights pair_weights(const SpectralSceneView& s, float w, float ta
     float sum = 0.0f;
     NEBULA_UNROLL
     for (int m = 0; m < kMaxTableNodes; ++m)
-      if (m < s.n_nodes) sum += s.node_to_power[q * kMaxTableNodes + m] * node[m];
-    p.b[q] = sum;
+      if (m < s.n_nodes) sum += s.node_weight[q * kMaxTableNodes + m] * node[m];
+    p.b[q] = light * sum;
   }
   p.n = s.n_nodes;
   return p;
+}
+// The same from the pair's thin-limit weight w (the voxel-light pre-pass, which
+// makes w with the phase folded in): b[0] = w without a table.
+NEBULA_HD PairWeights pair_weights(const SpectralSceneView& s, float w, float tau_v, float mu,
+                                   const ChordIrradiance* at = nullptr) {
+  const float thin = s.albedo * tau_v * hg_phase(mu, s.g);
+  if (s.n_nodes == 0 || !(thin > 0.0f)) {
+    PairWeights p = pair_weights_of_light(s, 0.0f, tau_v, mu, at);
+    p.b[0] = s.n_nodes == 0 ? w : 0.0f;
+    return p;
+  }
+  return pair_weights_of_light(s, w / thin, tau_v, mu, at);
 }
 
 // D_d's bound (diffuse_voxel_terms): a noisy node ratio must not make the
@@ -570,6 +595,14 @@ NEBULA_HD void add_pair(const SpectralSceneView& s, int star, const PairWeights&
       const auto add_block = [&](int p, float wp) {
         if constexpr (kMethod == SpectralMethod::Projection) {
           const float* c0 = s.coeff + (size_t(p) * s.n_depth + d0) * N;
+          if constexpr (Acc::kCols == 4) {
+            if (N == 4) {  // rows of 4 start on 16 bytes (the table's base is aligned): two vector reads
+              const NodeCell lo = reinterpret_cast<const NodeCell*>(c0)[0], hi = reinterpret_cast<const NodeCell*>(c0)[1];
+              NEBULA_UNROLL
+              for (int j = 0; j < 4; ++j) acc(star, j) += wp * (lo.v[j] + fd * (hi.v[j] - lo.v[j]));
+              return;
+            }
+          }
           for_each_index<Acc::kCols>(N, [&](int j) { acc(star, j) += wp * (c0[j] + fd * (c0[N + j] - c0[j])); });
         } else {
           const float u = s.stars[star].temperature_u;
@@ -945,11 +978,10 @@ NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir,
           if (!star_integrals(s, k, 0, cell, fd)) continue;
           const ChordIrradiance at = chord_irradiance<kChordPhase>(origin, dir, t, t + chord, s.stars[k].position, s.footprint);
           const Vec3 d = at.point - s.stars[k].position;
-          const float r = length(d);
-          const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
-          const PairWeights w = pair_weights(
-              s, s.stars[k].power * kInv4Pi * at.inv_r2 * s.albedo * tau_v * hg_phase(mu, s.g) * fraction, tau_v, mu,
-              kChordPhase ? &at : nullptr);
+          const float r2 = dot(d, d);
+          const float mu = r2 > 0.0f ? dot(d, to_eye) * reciprocal_sqrt(r2) : 0.0f;
+          const PairWeights w = pair_weights_of_light(s, s.stars[k].power * kInv4Pi * at.inv_r2 * fraction, tau_v, mu,
+                                                      kChordPhase ? &at : nullptr);
           for_each_index<kMaxTableNodes>(w.n, [&](int p) {
             const float* q = star_integrals(s, k, p, cell, fd);
             for_each_index<Acc::kCols>(F, [&](int f) {
@@ -968,11 +1000,11 @@ NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir,
       for_each_index<kMethod == SpectralMethod::Projection ? Acc::kRows : 0>(s.n_stars, [&](int k) {
         const ChordIrradiance at = chord_irradiance<kChordPhase>(origin, dir, t, t + chord, s.stars[k].position, s.footprint);
         const Vec3 d = at.point - s.stars[k].position;
-        const float r = length(d);
-        const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
-        const float w = s.stars[k].power * kInv4Pi * at.inv_r2 * s.albedo * tau_v * hg_phase(mu, s.g) * fraction;
-        add_pair<kMethod>(s, k, pair_weights(s, w, tau_v, mu, kChordPhase ? &at : nullptr), s.stars[k].depth_v[cell] + eye_depth,
-                          acc);
+        const float r2 = dot(d, d);
+        const float mu = r2 > 0.0f ? dot(d, to_eye) * reciprocal_sqrt(r2) : 0.0f;
+        const float light = s.stars[k].power * kInv4Pi * at.inv_r2 * fraction;
+        add_pair<kMethod>(s, k, pair_weights_of_light(s, light, tau_v, mu, kChordPhase ? &at : nullptr),
+                          s.stars[k].depth_v[cell] + eye_depth, acc);
         if (s.diffuse) add_diffuse<kMethod>(s, k, cell, fraction, eye_depth, acc);
       });
     }

@@ -644,6 +644,7 @@ SpectralSceneView view_of(const SpectralModel& m) {
   v.n_depth = m.settings.depth_nodes;
   v.n_temperature = m.n_temperature;
   v.depth_step = m.depth_step;
+  v.inv_depth_step = 1.0f / m.depth_step;
   v.coeff = m.coeff.data();
   v.star_coeff = m.star_coeff.data();
   v.n_powers = m.n_powers;
@@ -658,7 +659,10 @@ SpectralSceneView view_of(const SpectralModel& m) {
   for (size_t i = 0; i < m.node_kappa.size(); ++i) v.node_kappa[i] = float(m.node_kappa[i]);
   const int K = int(m.node_kappa.size());
   for (int p = 0; p < K; ++p)
-    for (int k = 0; k < K; ++k) v.node_to_power[p * kMaxTableNodes + k] = float(m.node_to_power[size_t(p) * K + k]);
+    for (int k = 0; k < K; ++k) {
+      v.node_to_power[p * kMaxTableNodes + k] = float(m.node_to_power[size_t(p) * K + k]);
+      v.node_weight[p * kMaxTableNodes + k] = float(m.node_to_power[size_t(p) * K + k] / m.node_kappa[size_t(k)]);
+    }
   // Emission: the spectra's tables; each component's weight is the renderer's.
   v.n_emission = int(m.emission.size());
   v.n_emission_planes = m.n_emission_planes;

@@ -130,6 +130,12 @@ NodeTable node_table(const SpectralRenderInputs& in, const SpectralSceneView& vi
   return out;
 }
 
+void use_node_table(SpectralSceneView& view, const NodeTable& nodes, const float* values) {
+  view.node_table = values;
+  view.node_table_rows = nodes.rows;
+  view.node_table_inv_step = 1.0f / nodes.step;
+}
+
 void set_emission(SpectralSceneView& view, const SpectralRenderInputs& in, const std::vector<const float*>& grids) {
   for (size_t c = 0; c < in.emission.size(); ++c) {
     view.emission[c].weight = grids[c];
@@ -205,11 +211,7 @@ Image render_spectral_cpu(const SpectralRenderInputs& in, double* seconds) {
   const std::vector<float> C = in.table ? cumulative_rows(*in.table) : std::vector<float>{};
   set_table(view, in, in.table ? in.table->P.data() : nullptr, C.empty() ? nullptr : C.data(), node_P, node_C);
   const NodeTable nodes = node_table(in, view);
-  if (!nodes.values.empty()) {
-    view.node_table = nodes.values.data();
-    view.node_table_rows = nodes.rows;
-    view.node_table_step = nodes.step;
-  }
+  if (!nodes.values.empty()) use_node_table(view, nodes, nodes.values.data());
   const auto start = std::chrono::steady_clock::now();  // the per-view work is timed with the march
   const DiffuseTerms diffuse = diffuse_terms(in, view);
   if (in.diffuse) {

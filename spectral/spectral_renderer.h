@@ -114,5 +114,7 @@ struct NodeTable {
   float step = 1;
 };
 NodeTable node_table(const SpectralRenderInputs& in, const SpectralSceneView& view);
+// Points the view at a node table whose values lie at `values` (host or device).
+void use_node_table(SpectralSceneView& view, const NodeTable& nodes, const float* values);
 
 }  // namespace nebula::spectral

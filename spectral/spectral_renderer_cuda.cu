@@ -178,11 +178,7 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
   set_table(view, in, in.table ? upload(floats, in.table->P) : nullptr,
             in.table ? upload(floats, cumulative_rows(*in.table)) : nullptr, node_P, node_C);
   const NodeTable nodes = node_table(in, view);
-  if (!nodes.values.empty()) {
-    view.node_table = upload(floats, nodes.values);
-    view.node_table_rows = nodes.rows;
-    view.node_table_step = nodes.step;
-  }
+  if (!nodes.values.empty()) use_node_table(view, nodes, upload(floats, nodes.values));
   // Light between voxels: the per-view arrays where they lie (a CUDA pass leaves them on the
   // device; host arrays are uploaded here), the terms made by a kernel timed with the march.
   const size_t cells = in.density->shape.count();

@@ -317,9 +317,7 @@ TEST(SpectralRendererTables, NodeTableAgreesWithEachNodesLookup) {
     set_table(view, in, table.P.data(), nullptr);
     const NodeTable nodes = node_table(in, view);
     ASSERT_FALSE(nodes.values.empty());
-    view.node_table = nodes.values.data();
-    view.node_table_rows = nodes.rows;
-    view.node_table_step = nodes.step;
+    use_node_table(view, nodes, nodes.values.data());
     const TableView t = nebula::view_of(table);
     uint64_t counter = 0;
     double worst = 0;
