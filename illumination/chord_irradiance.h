@@ -69,18 +69,30 @@ NEBULA_HD float pixel_mean_b2(Vec3 off, float w, const RayFootprint& footprint) 
   return w2 / (mean * mean);
 }
 
-// The chord from origin + t0 dir to origin + t1 dir (unit dir) of a ray with
-// this footprint, lit by a star at `star`. kNearStar as pixel_mean_b2's.
+// What chord_irradiance needs of a star that does not change along a ray: the
+// closest approach tc and the pixel's b^2 there; closed_form: b^2 took
+// pixel_mean_b2's closed form (eight asinh), which a march near a star's image
+// takes once per ray (NearStar below) rather than at every cell of the ray.
+struct StarOnRay {
+  float tc = 0, b2 = 0;
+  bool closed_form = false;
+};
 template <bool kNearStar = true>
-NEBULA_HD ChordIrradiance chord_irradiance(Vec3 origin, Vec3 dir, float t0, float t1, Vec3 star,
-                                           const RayFootprint& footprint) {
-  ChordIrradiance out;
+NEBULA_HD StarOnRay star_on_ray(Vec3 origin, Vec3 dir, Vec3 star, const RayFootprint& footprint) {
   const Vec3 to_star = star - origin;
   const float tc = dot(to_star, dir);  // the closest approach along the ray
   const Vec3 off = to_star - tc * dir;
   const float w = footprint.width(tc);
   // The pixel's b^2, never 0 (a pixel has a width; a guard for a point camera).
-  const float b2 = fmaxf(pixel_mean_b2<kNearStar>(off, w, footprint), 1e-30f + 1e-12f * dot(to_star, to_star));
+  return {tc, fmaxf(pixel_mean_b2<kNearStar>(off, w, footprint), 1e-30f + 1e-12f * dot(to_star, to_star)),
+          kNearStar && dot(off, off) < 16.0f * w * w};
+}
+
+// The chord from origin + t0 dir to origin + t1 dir (unit dir) of a ray, lit
+// by a star at `star` (star_on_ray of the same ray).
+NEBULA_HD ChordIrradiance chord_irradiance(const StarOnRay& star, Vec3 origin, Vec3 dir, float t0, float t1) {
+  ChordIrradiance out;
+  const float tc = star.tc, b2 = star.b2;
   const float chord = t1 - t0;
   const float mid = 0.5f * (t0 + t1) - tc;
   const float r2_mid = b2 + mid * mid;
@@ -101,6 +113,44 @@ NEBULA_HD ChordIrradiance chord_irradiance(Vec3 origin, Vec3 dir, float t0, floa
   const float t = tc + b * tanf(0.5f * (a0 + a1));
   out.point = origin + fminf(fmaxf(t, t0), t1) * dir;
   return out;
+}
+
+// The same for a ray with this footprint and a star at `star`. kNearStar as
+// pixel_mean_b2's.
+template <bool kNearStar = true>
+NEBULA_HD ChordIrradiance chord_irradiance(Vec3 origin, Vec3 dir, float t0, float t1, Vec3 star,
+                                           const RayFootprint& footprint) {
+  return chord_irradiance(star_on_ray<kNearStar>(origin, dir, star, footprint), origin, dir, t0, t1);
+}
+
+// The first of a ray's stars (each with a .position) whose b^2 takes the closed
+// form, with its StarOnRay, taken once when the ray starts (k = -1: none, and
+// always without kNearStar). Rays at a star's image would otherwise take the
+// eight asinh at every cell: on an H200 they were the frame's longest rays.
+struct NearStar {
+  int k = -1;
+  StarOnRay on_ray;
+};
+template <bool kNearStar, class Star>
+NEBULA_HD NearStar near_star(const Star* stars, int n, Vec3 origin, Vec3 dir, const RayFootprint& footprint) {
+  NearStar out;
+  if constexpr (kNearStar)
+    for (int k = 0; k < n; ++k) {
+      const StarOnRay s = star_on_ray<true>(origin, dir, stars[k].position, footprint);
+      if (s.closed_form) {
+        out.k = k;
+        out.on_ray = s;
+        break;
+      }
+    }
+  return out;
+}
+// chord_irradiance<kNearStar> for star k at `star`, from `near` where it is that star.
+template <bool kNearStar>
+NEBULA_HD ChordIrradiance chord_irradiance(const NearStar& near, int k, Vec3 star, Vec3 origin, Vec3 dir, float t0,
+                                           float t1, const RayFootprint& footprint) {
+  if (kNearStar && k == near.k) return chord_irradiance(near.on_ray, origin, dir, t0, t1);
+  return chord_irradiance<kNearStar>(origin, dir, t0, t1, star, footprint);
 }
 
 // The same at one point (sampling marchers): 1 / r^2 there, r^2 softened by

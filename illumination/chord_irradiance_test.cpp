@@ -85,6 +85,35 @@ TEST(PixelMean, ItsSquaredDistanceIsContinuousAndTendsToBSquared) {
   EXPECT_NEAR(pixel_mean_b2({}, w, round) / (w * w), 1.0 / (4 * kPiD), 1e-6);
 }
 
+// The star at whose image a ray passes, taken once per ray (near_star), gives
+// every chord the same numbers as the per-chord form, for it and the others.
+TEST(ChordIrradiance, TheImagesStarOncePerRayEqualsThePerChordForm) {
+  struct Star {
+    Vec3 position;
+  };
+  const RayFootprint f{0.0f, 0.001f, {1, 0, 0}, {0, 1, 0}};
+  const Vec3 origin{0, 0, -5}, dir{0, 0, 1};
+  // Width at the stars (distance 5): 0.005. The second star within 4 widths
+  // of the ray, the first and third beyond them.
+  const Star stars[] = {{{0.3f, 0.1f, 0.0f}}, {{0.004f, -0.007f, 0.2f}}, {{0.012f, 0.02f, 0.4f}}};
+  const NearStar near = near_star<true>(stars, 3, origin, dir, f);
+  EXPECT_EQ(near.k, 1);
+  EXPECT_TRUE(near.on_ray.closed_form);
+  EXPECT_EQ(near_star<false>(stars, 3, origin, dir, f).k, -1);  // without kNearStar: none
+  const float chords[][2] = {{4.0f, 4.9f}, {5.1f, 5.3f}, {5.19f, 5.21f}, {5.3f, 5.5f}};
+  for (int k = 0; k < 3; ++k)
+    for (const auto& c : chords) {
+      const ChordIrradiance a = chord_irradiance<true>(near, k, stars[k].position, origin, dir, c[0], c[1], f);
+      const ChordIrradiance b = chord_irradiance<true>(origin, dir, c[0], c[1], stars[k].position, f);
+      EXPECT_EQ(a.inv_r2, b.inv_r2) << k;
+      EXPECT_EQ(a.a0, b.a0) << k;
+      EXPECT_EQ(a.a1, b.a1) << k;
+      EXPECT_EQ(a.point.z, b.point.z) << k;
+    }
+  // A ray far from every image: none.
+  EXPECT_EQ(near_star<true>(stars, 3, Vec3{1, 1, -5}, dir, f).k, -1);
+}
+
 TEST(ChordIrradiance, AStarOnTheRayOfAPointCameraStaysFinite) {
   const RayFootprint point_camera{};  // no width: the guard keeps b^2 above 0
   const ChordIrradiance e = chord_irradiance({0, 0, -1}, {0, 0, 1}, 0.5f, 1.5f, {0, 0, 0}, point_camera);

@@ -953,6 +953,7 @@ NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir,
   if (!clip_to_grid(g, origin, dir, far, t_enter, t_exit)) return;
   const float inv_voxel = 1.0f / g.voxel;
   const Vec3 to_eye = -dir;
+  const NearStar image_star = near_star<kChordPhase>(s.stars, s.n_stars, origin, dir, s.footprint);
   float t = t_enter, eye_depth = 0.0f;  // V-band depth from the eye to the current voxel's entry
   traverse_segment_cells(g, origin, origin + far * dir, [&](int ix, int iy, int iz, size_t cell, float chord) -> bool {
     const float tau_v = s.density.tau_v[cell];
@@ -976,7 +977,8 @@ NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir,
           while (!((near >> k) & 1u)) ++k;
           float fd = 0.0f;
           if (!star_integrals(s, k, 0, cell, fd)) continue;
-          const ChordIrradiance at = chord_irradiance<kChordPhase>(origin, dir, t, t + chord, s.stars[k].position, s.footprint);
+          const ChordIrradiance at = chord_irradiance<kChordPhase>(image_star, k, s.stars[k].position, origin, dir, t,
+                                                                    t + chord, s.footprint);
           const Vec3 d = at.point - s.stars[k].position;
           const float r2 = dot(d, d);
           const float mu = r2 > 0.0f ? dot(d, to_eye) * reciprocal_sqrt(r2) : 0.0f;
@@ -998,7 +1000,8 @@ NEBULA_HD void march_spectral(const SpectralSceneView& s, Vec3 origin, Vec3 dir,
     } else if (tau_v > 0.0f) {
       // Projection's accumulators have a row per star: unrolled over the stars, so that row is a constant.
       for_each_index<kMethod == SpectralMethod::Projection ? Acc::kRows : 0>(s.n_stars, [&](int k) {
-        const ChordIrradiance at = chord_irradiance<kChordPhase>(origin, dir, t, t + chord, s.stars[k].position, s.footprint);
+        const ChordIrradiance at = chord_irradiance<kChordPhase>(image_star, k, s.stars[k].position, origin, dir, t,
+                                                                    t + chord, s.footprint);
         const Vec3 d = at.point - s.stars[k].position;
         const float r2 = dot(d, d);
         const float mu = r2 > 0.0f ? dot(d, to_eye) * reciprocal_sqrt(r2) : 0.0f;
