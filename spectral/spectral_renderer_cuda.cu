@@ -20,12 +20,22 @@ namespace {
 thread_local SideStream near_rays;  // the launch of the rays near a star (spectral_kernel)
 thread_local SideStream star_pixel_rays;  // the star pixels' rays, on their own beside both launches
 
+// Blocks of 256 rays per multiprocessor the main launch (kNear false) is held
+// to: the projection's at 3 (at most 80 registers, against 113 unbounded). One
+// H200 run, each bound a build's variant (docs/performance.md): the Fig. 12
+// scene's projection 0.94 -> 0.84 ms at 512^2, the noise cube's 0.47 -> 0.46 ms
+// (its frame waits on the near rays); the other methods slower held so (on the
+// noise cube the light basis 0.58 -> 0.68 ms, voxel light 1.48 -> 1.72 ms,
+// pre-integration 0.46 -> 0.49 ms, the double integral's 20 samples 2.16 ->
+// 2.59 ms), so they and the near rays' launch keep the compiler's choice.
+constexpr int main_min_blocks(SpectralMethod m) { return m == SpectralMethod::Projection ? 3 : 1; }
+
 // kNear: the rays passes_near_a_star picks (the phase's mean over their
 // chords' angles), else the others; a launch of each marches every pixel once.
 // The split keeps that mean out of the main kernel's registers (the near
 // rays' launch runs beside it on a SideStream); the image is the CPU loop's.
 template <SpectralMethod kMethod, class Acc, bool kNear>
-__global__ void spectral_kernel(SpectralSceneView scene, Camera camera, float* pixels) {
+__global__ void __launch_bounds__(256, kNear ? 1 : main_min_blocks(kMethod)) spectral_kernel(SpectralSceneView scene, Camera camera, float* pixels) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x;
   const int y = blockIdx.y * blockDim.y + threadIdx.y;
   if (x >= camera.width || y >= camera.height) return;
