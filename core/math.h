@@ -18,4 +18,14 @@ NEBULA_HD T clamp(T v, T lo, T hi) {
   return v < lo ? lo : (v > hi ? hi : v);
 }
 
+// 1 / sqrt(x): the GPU's reciprocal square root (within 2 ulp), the CPU's
+// quotient; for per-pair arithmetic in marchers that avoid divisions.
+NEBULA_HD float reciprocal_sqrt(float x) {
+#ifdef __CUDA_ARCH__
+  return rsqrtf(x);
+#else
+  return 1.0f / sqrtf(x);
+#endif
+}
+
 }  // namespace nebula

@@ -17,10 +17,13 @@ constexpr float kHgIsotropicBelow = 1e-3f;
 // Phase function per steradian, normalised over 4 pi; mu = cos(theta).
 // 1 + g^2 - 2 g mu is written around the peak, (1 - |g|)^2 + 2|g|(1 -+ mu),
 // so that it keeps its precision (and stays positive) as |g| -> 1 near the peak.
+// Its -3/2 power by one reciprocal square root, no division: the spectral
+// march takes it per voxel and star.
 NEBULA_HD float hg_phase(float g, float mu) {
   const float h = fabsf(g), q = g >= 0.0f ? 1.0f - mu : 1.0f + mu;
   const float denom = (1.0f - h) * (1.0f - h) + 2.0f * h * q;
-  return kInv4Pi * (1.0f - h) * (1.0f + h) / (denom * sqrtf(denom));
+  const float r = reciprocal_sqrt(denom);
+  return kInv4Pi * (1.0f - h) * (1.0f + h) * (r * r * r);
 }
 
 // A sampled deflection: cosine and sine of the polar angle. Both are kept

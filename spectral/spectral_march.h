@@ -50,6 +50,7 @@
 #include "core/hd.h"
 #include "core/math.h"
 #include "illumination/chord_irradiance.h"
+#include "montecarlo/henyey_greenstein.h"
 #include "spectral/expint.h"
 #include "tables/chord_phase.h"
 #include "tables/table_lookup.h"
@@ -199,24 +200,6 @@ NEBULA_HD bool depth_row(const SpectralSceneView& s, float D, int& d0, float& fd
   return true;
 }
 
-// 1 / sqrt(x): the GPU's reciprocal square root (within 2 ulp), the CPU's
-// quotient; for the march's per-pair arithmetic (no division there).
-NEBULA_HD float reciprocal_sqrt(float x) {
-#ifdef __CUDA_ARCH__
-  return rsqrtf(x);
-#else
-  return 1.0f / sqrtf(x);
-#endif
-}
-
-// Henyey-Greenstein phase function per steradian: (1 - g^2) / (4 pi) d^(-3/2),
-// d = 1 + g^2 - 2 g mu, by one reciprocal square root (per pair on the march).
-NEBULA_HD float hg_phase(float mu, float g) {
-  const float d = 1.0f + g * g - 2.0f * g * mu;
-  const float r = reciprocal_sqrt(d);
-  return (1.0f - g * g) * kInv4Pi * (r * r * r);
-}
-
 // Every node's table value for a voxel of V-band depth tau_v at the table's
 // angle coordinate u, from SpectralSceneView::node_table: bilinear in (tau_v,
 // u) between its rows and bin centres, as TableView::lookup_at is in (tau_sct,
@@ -273,7 +256,7 @@ NEBULA_HD PairWeights pair_weights_of_light(const SpectralSceneView& s, float li
                                             const ChordIrradiance* at = nullptr) {
   PairWeights p;
   p.tau_sct = s.albedo * tau_v;
-  p.b[0] = light * p.tau_sct * hg_phase(mu, s.g);
+  p.b[0] = light * p.tau_sct * hg_phase(s.g, mu);
   p.n = 1;
   p.scale = 0.0f;
   p.u = 0.0f;
@@ -303,7 +286,7 @@ NEBULA_HD PairWeights pair_weights_of_light(const SpectralSceneView& s, float li
       t.P = s.node_P[m];
       t.C = s.node_C[m];
     }
-    node[m] = !t.P   ? tau_sct * hg_phase(mu, s.node_g[m])
+    node[m] = !t.P   ? tau_sct * hg_phase(s.node_g[m], mu)
               : p.mean ? chord_phase_mean(t, tau_sct, p.a0, p.a1, nullptr)
                        : t.lookup_at(tau_sct, p.u);
   }
@@ -323,7 +306,7 @@ NEBULA_HD PairWeights pair_weights_of_light(const SpectralSceneView& s, float li
 // makes w with the phase folded in): b[0] = w without a table.
 NEBULA_HD PairWeights pair_weights(const SpectralSceneView& s, float w, float tau_v, float mu,
                                    const ChordIrradiance* at = nullptr) {
-  const float thin = s.albedo * tau_v * hg_phase(mu, s.g);
+  const float thin = s.albedo * tau_v * hg_phase(s.g, mu);
   if (s.n_nodes == 0 || !(thin > 0.0f)) {
     PairWeights p = pair_weights_of_light(s, 0.0f, tau_v, mu, at);
     p.b[0] = s.n_nodes == 0 ? w : 0.0f;
@@ -531,7 +514,7 @@ NEBULA_HD void add_pair(const SpectralSceneView& s, int star, const PairWeights&
         for (int i = 0; i < s.n_lambda; ++i) {
           // The thin limit at this wavelength's own albedo and g: P / kappa = a tau p_HG.
           const float e =
-              w.scale * s.lambda_albedo[i] * w.tau_v * hg_phase(w.mu, s.lambda_g[i]) * expf(-s.kappa[i] * D);
+              w.scale * s.lambda_albedo[i] * w.tau_v * hg_phase(s.lambda_g[i], w.mu) * expf(-s.kappa[i] * D);
           for_each_index<Acc::kCols>(s.n_acc, [&](int f) { acc(0, f) += q[f * s.n_lambda + i] * e; });
         }
       } else {
