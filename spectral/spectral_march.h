@@ -256,7 +256,7 @@ NEBULA_HD PairWeights pair_weights_of_light(const SpectralSceneView& s, float li
                                             const ChordIrradiance* at = nullptr) {
   PairWeights p;
   p.tau_sct = s.albedo * tau_v;
-  p.b[0] = light * p.tau_sct * hg_phase(s.g, mu);
+  p.b[0] = 0.0f;
   p.n = 1;
   p.scale = 0.0f;
   p.u = 0.0f;
@@ -264,7 +264,10 @@ NEBULA_HD PairWeights pair_weights_of_light(const SpectralSceneView& s, float li
   p.mu = mu;
   p.a0 = p.a1 = 0.0f;
   p.mean = false;
-  if (s.n_nodes == 0) return p;
+  if (s.n_nodes == 0) {  // the thin limit: p_HG (with a table its nodes' values replace it)
+    p.b[0] = light * p.tau_sct * hg_phase(s.g, mu);
+    return p;
+  }
   if (!(p.tau_sct > 0.0f)) light = 0.0f;  // no scattering: every weight 0
   p.scale = light;
   p.u = s.table.angle_coordinate(mu);
