@@ -1,6 +1,7 @@
 #include "pipeline/table_source.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -10,7 +11,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <list>
 #include <map>
+#include <mutex>
 #include <sstream>
 
 #include "core/error.h"
@@ -71,6 +74,70 @@ std::string mismatch(const ScatteringTable& t, const TabulateParams& p) {
   return "";
 }
 
+// Cache entries this process has read and checked, by path, with the file's
+// size and modification time then: a sweep or a Python loop asks for the same
+// few tables again and again (3-4 ms a read of HDF5), and an entry that
+// changed on disk since is read and checked again. The most recent kMemoEntries.
+class CheckedEntries {
+ public:
+  static constexpr size_t kMemoEntries = 64;
+  // The file as stat(2) sees it: a rewrite (the cache writes aside and renames,
+  // so a new inode) or any change of size or times makes another stamp.
+  struct Stamp {
+    dev_t device = 0;
+    ino_t inode = 0;
+    off_t size = 0;
+    long long mtime_ns = 0, ctime_ns = 0;
+    bool operator==(const Stamp& o) const {
+      return device == o.device && inode == o.inode && size == o.size && mtime_ns == o.mtime_ns &&
+             ctime_ns == o.ctime_ns;
+    }
+  };
+  static bool stamp_of(const std::filesystem::path& path, Stamp& out) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0) return false;
+    out.device = st.st_dev;
+    out.inode = st.st_ino;
+    out.size = st.st_size;
+    out.mtime_ns = (long long)st.st_mtim.tv_sec * 1000000000LL + st.st_mtim.tv_nsec;
+    out.ctime_ns = (long long)st.st_ctim.tv_sec * 1000000000LL + st.st_ctim.tv_nsec;
+    return true;
+  }
+  std::shared_ptr<const ScatteringTable> find(const std::string& path, const Stamp& stamp) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (auto it = entries_.begin(); it != entries_.end(); ++it)
+      if (it->path == path) {
+        if (!(it->stamp == stamp)) {
+          entries_.erase(it);
+          return nullptr;
+        }
+        entries_.splice(entries_.begin(), entries_, it);  // most recent first
+        return entries_.front().table;
+      }
+    return nullptr;
+  }
+  void add(const std::string& path, const Stamp& stamp, std::shared_ptr<const ScatteringTable> table) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    entries_.remove_if([&](const Entry& e) { return e.path == path; });
+    entries_.push_front({path, stamp, std::move(table)});
+    if (entries_.size() > kMemoEntries) entries_.pop_back();
+  }
+
+ private:
+  struct Entry {
+    std::string path;
+    Stamp stamp;
+    std::shared_ptr<const ScatteringTable> table;
+  };
+  std::mutex mutex_;
+  std::list<Entry> entries_;
+};
+
+CheckedEntries& checked_entries() {
+  static CheckedEntries memo;
+  return memo;
+}
+
 }  // namespace
 
 std::string table_cache_name(const TabulateParams& p) {
@@ -88,13 +155,22 @@ ScatteringTable cached_table(const TabulateParams& p, Backend backend, bool prog
   if (path_out) *path_out = path.string();
   std::error_code ec;
   if (std::filesystem::exists(path, ec)) {
-    // An entry is trusted only once read, checked and found to be the table asked for.
+    // An entry is trusted only once read, checked and found to be the table
+    // asked for (the path holds every parameter, so once per unchanged file).
+    CheckedEntries::Stamp stamp;
+    const bool stamped = CheckedEntries::stamp_of(path, stamp);
+    if (stamped)
+      if (std::shared_ptr<const ScatteringTable> known = checked_entries().find(path.string(), stamp)) {
+        if (origin) *origin = TableOrigin::Cache;
+        return *known;
+      }
     std::string problem;
     try {
       ScatteringTable cached = read_own_table(path.string());
       problem = mismatch(cached, p);
       if (problem.empty()) {
         if (origin) *origin = TableOrigin::Cache;
+        if (stamped) checked_entries().add(path.string(), stamp, std::make_shared<const ScatteringTable>(cached));
         return cached;
       }
     } catch (const Error& e) {

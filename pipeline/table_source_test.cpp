@@ -136,6 +136,16 @@ TEST_F(TableSource, BadCacheEntriesAreGeneratedAgainWithAWarning) {
   EXPECT_EQ(foreign.report[0].origin, TableOrigin::Generated);
   EXPECT_NE(foreign.report[0].warning.find("g is 0.25, not 0.5"), std::string::npos) << foreign.report[0].warning;
   EXPECT_EQ(foreign.per_band[0]->g, 0.5);
+
+  // An entry read and checked is kept in the process; replacing the file
+  // afterwards is seen (its stamp changes), not served from memory.
+  const BandTables again = resolve(scene("g = 0.5"));
+  ASSERT_EQ(again.report[0].origin, TableOrigin::Cache);
+  EXPECT_EQ(resolve(scene("g = 0.5")).per_band[0]->P, again.per_band[0]->P);
+  std::filesystem::copy_file(path("foreign.h5"), entry, std::filesystem::copy_options::overwrite_existing);
+  const BandTables replaced = resolve(scene("g = 0.5"));
+  EXPECT_EQ(replaced.report[0].origin, TableOrigin::Generated);
+  EXPECT_EQ(replaced.per_band[0]->g, 0.5);
 }
 
 // Issue 17, item 3: an unwritable cache folder fails before the Monte-Carlo
