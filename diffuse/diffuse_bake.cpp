@@ -31,8 +31,9 @@ void check_options(const DiffuseBakeOptions& o) {
     throw ParameterError("diffuse_zonal", "must be 0 (none) or " + std::to_string(o.degree + 1) + " to " +
                                               std::to_string(kMaxZonalDegree) + " (above diffuse_order), got " +
                                               std::to_string(o.zonal));
-  if (o.shared_order_buckets < 0 || o.shared_order_buckets > 16)
-    throw ParameterError("shared_order_buckets", "must be 0 to 16, got " + std::to_string(o.shared_order_buckets));
+  if (o.shared_order_buckets < -1 || o.shared_order_buckets > kMaxOrderBuckets)
+    throw ParameterError("shared_order_buckets", "must be -1 (auto) or 0 to " + std::to_string(kMaxOrderBuckets) +
+                                                     ", got " + std::to_string(o.shared_order_buckets));
 }
 
 // The relative L2 noise of a band's l = 0 field from its two halves: the
@@ -52,6 +53,13 @@ double field_noise(const std::vector<double>& l0, const std::vector<double>& odd
 }
 
 }  // namespace
+
+int shared_order_buckets_for(const DiffuseBakeOptions& o, Backend backend, size_t cells, int n_coeffs) {
+  if (o.shared_order_buckets >= 0) return o.shared_order_buckets;
+  if (backend != Backend::Cuda) return 8;
+  const size_t bucket = std::max<size_t>(1, cells * size_t(n_coeffs) * sizeof(unsigned long long));
+  return int(std::clamp<size_t>(kSharedBucketBytes / bucket, 8, kMaxOrderBuckets));
+}
 
 DiffuseSlots diffuse_slots(const DiffusePassInputs& in, size_t cells, int n_coeffs) {
   DiffuseSlots l;
@@ -241,7 +249,7 @@ std::vector<DiffuseField> bake_diffuse_shared(const DensityGrid& density,
     in.roulette_start = o.roulette_start;
     in.max_orders = o.max_orders;
     in.private_sums_bytes = o.private_sums_bytes;
-    in.order_buckets = o.shared_order_buckets;
+    in.order_buckets = shared_order_buckets_for(o, backend, cells.count(), n_coeffs);
     passes.push_back(std::move(in));
     // Sums of weight x (chord / edge) x Y, each weight in units of the total
     // power / photons: L_k = sum x (power / photons) x edge / (volume inside the grid).

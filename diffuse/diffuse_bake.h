@@ -38,8 +38,11 @@ struct DiffuseBakeOptions {
   size_t private_sums_bytes = size_t(1) << 30;
   // Albedos sharing a pass: flights after collisions 1..this many deposit
   // once for all albedos (their weights applied after the pass), later ones
-  // once per albedo. 0 to 16; the same fields either way, up to rounding.
-  int shared_order_buckets = 8;
+  // once per albedo. 0 to kMaxOrderBuckets; the same fields either way, up to
+  // rounding. -1 (auto): 8 on the CPU (its per-thread sums' budget above), on
+  // CUDA as many as kSharedBucketBytes holds, 8 to kMaxOrderBuckets
+  // (shared_order_buckets_for).
+  int shared_order_buckets = -1;
   // "diffuse_zonal": degrees degree + 1 .. this of each of the brightest
   // kMaxZonalStars stars' light, about the direction from the star (0: none).
   int zonal = 0;
@@ -51,6 +54,16 @@ struct DiffuseBakeOptions {
   // each band its own streams (independent noise per band).
   bool common_streams = false;
 };
+
+// Device memory the order buckets of one shared CUDA pass may take (auto).
+// More buckets mean fewer deposits per flight: at a = 0.9 a flight has
+// survived n collisions with probability about 0.9^n, so beyond 8 buckets 43%
+// of flights deposit once per albedo, beyond 32 3%; the deposits are
+// atomics spread over the sums, which no longer fit the L2 cache.
+constexpr size_t kSharedBucketBytes = size_t(2) << 30;
+
+// The bucket count a shared pass uses: `options` unless auto (above).
+int shared_order_buckets_for(const DiffuseBakeOptions& options, Backend backend, size_t cells, int n_coeffs);
 
 struct DiffuseBakeStats {
   double seconds = 0;                // the photon passes (CUDA events on the GPU)

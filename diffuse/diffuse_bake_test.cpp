@@ -306,7 +306,9 @@ TEST(DiffuseBake, RefusesBadOptionsNamingThem) {
   o.photons = 0;
   EXPECT_EQ(parameter(o), "diffuse_photons");
   o = {};
-  o.shared_order_buckets = 17;
+  o.shared_order_buckets = kMaxOrderBuckets + 1;
+  EXPECT_EQ(parameter(o), "shared_order_buckets");
+  o.shared_order_buckets = -2;
   EXPECT_EQ(parameter(o), "shared_order_buckets");
   band.table = nullptr;
   EXPECT_THROW(bake_diffuse(grid, {band}, stars, DiffuseBakeOptions{}, Backend::Cpu), Error);
@@ -392,6 +394,43 @@ TEST(DiffuseBakeShared, EachOrderIsWeightedByTheAlbedoRatioToItsPower) {
   }
   EXPECT_EQ(shared[0].band_coeffs(0), f12.band_coeffs(0)) << "the traced albedo's set is the plain bake";
  }
+}
+
+// The bucket count changes where an order's deposits are weighted (after the
+// pass, in double, or per deposit, in float), not the field: 8 and
+// kMaxOrderBuckets buckets give the same fields up to rounding. Auto takes 8
+// on the CPU and, on CUDA, as many as kSharedBucketBytes holds.
+TEST(DiffuseBakeShared, BucketCountsGiveTheSameFields) {
+  const SharedCase c;
+  DiffuseBakeOptions o;
+  o.photons = 20000;
+  o.cells = 6;
+  const std::vector<std::vector<DiffuseBand>> sets{c.bands(0.95f, 0.95f), c.bands(0.3f, 0.6f), c.bands(0.6f, 0.4f)};
+  o.shared_order_buckets = 8;
+  const std::vector<DiffuseField> few = bake_diffuse_shared(c.grid, sets, c.stars, o, Backend::Cpu);
+  o.shared_order_buckets = kMaxOrderBuckets;
+  const std::vector<DiffuseField> many = bake_diffuse_shared(c.grid, sets, c.stars, o, Backend::Cpu);
+  for (size_t s = 0; s < sets.size(); ++s)
+    for (size_t b = 0; b < 2; ++b) {
+      const std::vector<float> x = few[s].band_coeffs(b), y = many[s].band_coeffs(b);
+      ASSERT_EQ(x.size(), y.size());
+      double err = 0, norm = 0;
+      for (size_t i = 0; i < x.size(); ++i) {
+        err = std::max(err, std::fabs(double(x[i]) - y[i]));
+        norm = std::max(norm, std::fabs(double(x[i])));
+      }
+      ASSERT_GT(norm, 0.0);
+      EXPECT_LT(err, 1e-5 * norm) << "set " << s << " band " << b;
+    }
+  DiffuseBakeOptions automatic;
+  EXPECT_EQ(shared_order_buckets_for(automatic, Backend::Cpu, 64 * 64 * 64, 25), 8);
+  EXPECT_EQ(shared_order_buckets_for(automatic, Backend::Cuda, 64 * 64 * 64, 25), kMaxOrderBuckets);
+  EXPECT_EQ(shared_order_buckets_for(automatic, Backend::Cuda, 256 * 256 * 256, 25), 8);
+  const size_t cells = 64 * 64 * 64;
+  const int by_budget = int(kSharedBucketBytes / (cells * 37 * sizeof(unsigned long long)));
+  EXPECT_EQ(shared_order_buckets_for(automatic, Backend::Cuda, cells, 37), by_budget);
+  automatic.shared_order_buckets = 3;
+  EXPECT_EQ(shared_order_buckets_for(automatic, Backend::Cuda, cells, 25), 3);
 }
 
 // Every order, roulette included: the shared estimate of a smaller albedo's

@@ -41,6 +41,7 @@ constexpr uint32_t kPurposeDiffuse = 0x4446u;  // "DF"
 constexpr int kDiffuseMaxOrders = 10000;  // a photon is stopped (and counted) beyond this
 constexpr float kDiffuseFixedScale = 268435456.0f;  // 2^28: one unit of weight x cell edge
 constexpr int kMaxAlbedoSlots = 16;  // albedos one pass deposits for
+constexpr int kMaxOrderBuckets = 32;  // orders a shared pass deposits once for every albedo (DiffuseSlots)
 
 // One band's photon pass, by value (host or device pointers).
 struct DiffusePhotonScene {
