@@ -1,9 +1,15 @@
 #!/usr/bin/env bash
 # Runs on the lent GPU machine (see docs/performance.md): GPU tests, the
 # validation suite on CUDA, benchmarks, and the full default table, writing
-# logs and files under $OUT. Expects the bundle made by scripts/device-bundle.sh.
+# logs and files under $OUT. Expects the bundle made by scripts/device-bundle.sh,
+# carried as .devpack/ (unpacked here into .devbundle/ when that is absent).
 set -uo pipefail
 B=${BUNDLE:-.devbundle}
+if [ ! -x "$B/bin/nebula" ] && [ -f .devpack/bundle.tar.xz ]; then
+  mkdir -p "$B"
+  if command -v xz >/dev/null; then tar -C "$B" -xJf .devpack/bundle.tar.xz
+  else python3 -c "import sys, tarfile; tarfile.open(sys.argv[1]).extractall(sys.argv[2])" .devpack/bundle.tar.xz "$B"; fi
+fi
 export LD_LIBRARY_PATH=$PWD/$B/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 export NEBULA_DATA_DIR=$PWD/data
 OUT=${OUT:-/tmp/nebula-out}
