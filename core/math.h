@@ -28,4 +28,15 @@ NEBULA_HD float reciprocal_sqrt(float x) {
 #endif
 }
 
+// 1 / x for 0 < |x| < 2^126: the GPU's reciprocal without IEEE rounding's
+// Newton steps and slow-path test (within 2 ulp; the CUDA files are built
+// without fast math, so 1.0f / x is a subroutine), the CPU's quotient.
+NEBULA_HD float reciprocal(float x) {
+#ifdef __CUDA_ARCH__
+  return __fdividef(1.0f, x);
+#else
+  return 1.0f / x;
+#endif
+}
+
 }  // namespace nebula

@@ -100,7 +100,7 @@ NEBULA_HD ChordIrradiance chord_irradiance(const StarOnRay& star, Vec3 origin, V
   // middle to within (chord / 2)^2 / r^2 < 0.1%: most cells take this branch and
   // skip the three transcendentals below.
   if (0.25f * chord * chord < 1e-3f * r2_mid) {
-    out.inv_r2 = 1.0f / r2_mid;
+    out.inv_r2 = reciprocal(r2_mid);
     out.point = origin + (tc + mid) * dir;
     return out;
   }

@@ -96,10 +96,11 @@ template <bool kChordPhase = false, class Scene>
 NEBULA_HD void add_star_light(const Scene& s, Vec3 star, const float* power, float depth_v, const ChordIrradiance& at,
                               float tau_v, Vec3 to_eye, float* source, int* clamps) {
   const Vec3 d = at.point - star;
-  const float r = length(d);
-  // theta: between the light's direction (star to dust) and the way to the eye.
-  const float mu = r > 0.0f ? dot(d, to_eye) / r : 0.0f;
-  float u = TableView::kNoAngle;  // the angle's bin coordinate, shared by bands with equal binning
+  const float r2 = dot(d, d);
+  // theta: between the light's direction (star to dust) and the way to the eye;
+  // one reciprocal square root, no division (docs/performance.md, "Axial maps").
+  const float mu = r2 > 0.0f ? dot(d, to_eye) * reciprocal_sqrt(r2) : 0.0f;  // the bins clamp it to [-1, 1]
+  TableView::AngleCell u;  // the angle's bin cell, shared by bands with equal binning
   int u_from = -1;
   NEBULA_UNROLL
   for (int b = 0; b < kMaxBands; ++b) {
@@ -115,7 +116,7 @@ NEBULA_HD void add_star_light(const Scene& s, Vec3 star, const float* power, flo
     }
     if (u_from < 0 || s.table[b].bins.kind != s.table[u_from].bins.kind ||
         s.table[b].bins.n != s.table[u_from].bins.n) {
-      u = s.table[b].angle_coordinate(mu);
+      u = s.table[b].angle_cell(s.table[b].angle_coordinate(mu));
       u_from = b;
     }
     source[b] += e * s.table[b].lookup_at(s.albedo[b] * tau_b, u, clamps);

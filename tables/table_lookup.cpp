@@ -33,6 +33,7 @@ TableView view_of(const ScatteringTable& table) {
   view.n_tau = table.n_tau();
   view.n_mu = table.n_mu();
   view.tau_max = static_cast<float>(table.tau_max());
+  view.tau_scale = table.tau_max() > 0.0 ? static_cast<float>((table.n_tau() - 1) / table.tau_max()) : 0.0f;
   view.bins = table.bins();
   return view;
 }

@@ -21,6 +21,7 @@ struct TableView {
   int n_tau = 0;
   int n_mu = 0;
   float tau_max = 0.0f;
+  float tau_scale = 0.0f;  // (n_tau - 1) / tau_max (0 when tau_max is): a row found by a product, not a division
   AngularBins bins;
 
   // Bilinear in (tau, bin coordinate): linear in tau between rows and linear
@@ -40,28 +41,40 @@ struct TableView {
     return mu == mu ? bins.position(mu) - 0.5f : kNoAngle;
   }
 
+  // The bin centres around an angle coordinate and the fraction between them:
+  // what every table of the same bins shares at one angle (angle_cell).
+  struct AngleCell {
+    int k0 = 0, k1 = 0;
+    float fu = 0.0f;
+    bool none = true;  // kNoAngle: looked up at u = 0 and counted as a clamp
+  };
+  NEBULA_HD AngleCell angle_cell(float u) const {
+    AngleCell c;
+    c.none = u < -0.75f;  // kNoAngle: positions are never below -0.5
+    cell(c.none ? 0.0f : u, n_mu, c.k0, c.fu);
+    c.k1 = c.k0 + 1 < n_mu ? c.k0 + 1 : c.k0;
+    return c;
+  }
+
   // lookup() with the angle given as angle_coordinate(mu).
   NEBULA_HD float lookup_at(float tau_sct, float u, int* clamped = nullptr) const {
+    return lookup_at(tau_sct, angle_cell(u), clamped);
+  }
+
+  // The same with the angle's cell, from angle_cell of a table with these bins.
+  NEBULA_HD float lookup_at(float tau_sct, const AngleCell& a, int* clamped = nullptr) const {
     if (P == nullptr || n_tau < 1 || n_mu < 1) return 0.0f;
     int i0, i1;
     float ft;
-    bool outside = rows(tau_sct, i0, i1, ft);
-    if (u < -0.75f) {  // kNoAngle: positions are never below -0.5
-      u = 0.0f;
-      outside = true;
-    }
+    const bool outside = rows(tau_sct, i0, i1, ft) || a.none;
     if (outside && clamped != nullptr) *clamped += 1;
-    int k0;
-    float fu;
-    cell(u, n_mu, k0, fu);
-    const int k1 = k0 + 1 < n_mu ? k0 + 1 : k0;
-
     // Weighted form (not a + f (b - a)): exact at grid nodes and free of
     // cancellation for non-negative P.
+    const float fu = a.fu;
     const float* row0 = P + static_cast<long long>(i0) * n_mu;
     const float* row1 = P + static_cast<long long>(i1) * n_mu;
-    const float v0 = (1.0f - fu) * row0[k0] + fu * row0[k1];
-    const float v1 = (1.0f - fu) * row1[k0] + fu * row1[k1];
+    const float v0 = (1.0f - fu) * row0[a.k0] + fu * row0[a.k1];
+    const float v1 = (1.0f - fu) * row1[a.k0] + fu * row1[a.k1];
     return (1.0f - ft) * v0 + ft * v1;
   }
 
@@ -98,7 +111,7 @@ struct TableView {
       outside = true;
     }
     // The tau axis is uniform, so the row is found in O(1).
-    const float x = tau_max > 0.0f ? tau / tau_max * static_cast<float>(n_tau - 1) : 0.0f;
+    const float x = tau * tau_scale;
     cell(x, n_tau, i0, ft);
     i1 = i0 + 1 < n_tau ? i0 + 1 : i0;
     return outside;
