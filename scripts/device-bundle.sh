@@ -6,7 +6,7 @@
 # about 40 MB (the test binaries share most of their fatbins; its window finds
 # them). Build without OpenImageIO first (its libraries are too large to carry):
 #   cmake -S . -B build-device -DNEBULA_CUDA=ON -DNEBULA_OPENIMAGEIO=OFF && cmake --build build-device
-# then: BUILD=build-device scripts/device-bundle.sh, carry .devpack, and run
+# then: BUILD=build-device [EXTRA_BINS="..."] scripts/device-bundle.sh, carry .devpack, and run
 # scripts/device-run.sh there (it unpacks the archive).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,6 +15,10 @@ bins=("$build"/bin/nebula "$build"/bin/core_tests "$build"/bin/montecarlo_tests 
       "$build"/bin/illumination_tests "$build"/bin/raycast_tests "$build"/bin/axial_tests "$build"/bin/multires_tests
       "$build"/bin/truth_tests "$build"/bin/pipeline_tests "$build"/bin/diffuse_tests)
 bins+=("$build"/bin/*_gpu_tests)
+# EXTRA_BINS: more binaries to carry (e.g. a baseline build's nebula, copied under
+# another name, to time the two builds alternately in one call).
+read -r -a extra <<<"${EXTRA_BINS:-}"
+bins+=("${extra[@]}")
 # The shared tool copies and checks that every library resolves; its size check is
 # for an unpacked bundle, so only its other failures stop this script.
 if ! log=$(../shared/tools/device-bundle .devbundle "${bins[@]}" -- scenes 2>&1); then
