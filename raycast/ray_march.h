@@ -107,7 +107,7 @@ NEBULA_HD void add_star_light(const Scene& s, Vec3 star, const float* power, flo
     if (b >= s.n_bands) break;
     if (!(s.albedo[b] > 0.0f)) continue;
     const float tau_b = tau_v * s.extinction_ratio[b];
-    const float e = power[b] * kInv4Pi * at.inv_r2 * expf(-depth_v * s.extinction_ratio[b]);
+    const float e = power[b] * kInv4Pi * at.inv_r2 * fast_exp(-depth_v * s.extinction_ratio[b]);
     if constexpr (kChordPhase) {
       if (chord_takes_phase_mean(s.table[b], at.a0, at.a1)) {
         source[b] += e * chord_phase_mean(s.table[b], s.albedo[b] * tau_b, at.a0, at.a1, clamps);
