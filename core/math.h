@@ -40,7 +40,7 @@ NEBULA_HD float reciprocal(float x) {
 }
 
 // e^x for the attenuation of light in the shading (x <= 0): the GPU's __expf
-// (one ex2.approx; within 2 + 1.173 |x| ulp, the CUDA Programming Guide's
+// (one ex2.approx; within 2 + floor(1.173 |x|) ulp, the CUDA Programming Guide's
 // table of intrinsic functions; core_gpu_tests measures it), the CPU's expf.
 // exp(0) = 1 exactly on both.
 NEBULA_HD float fast_exp(float x) {
