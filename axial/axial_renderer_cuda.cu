@@ -5,7 +5,6 @@
 #include <cuda_runtime.h>
 
 #include <memory>
-#include <optional>
 #include <vector>
 
 #include "axial/axial_renderer.h"
@@ -32,11 +31,11 @@ namespace {
 // same template.
 template <AxialSkip kMode, bool kStars, AxialField kField, bool kDeform>
 __global__ void __launch_bounds__(256, NEBULA_AXIAL_MIN_BLOCKS)
-    axial_kernel(AxialMarchScene scene, Camera camera, int2 first_tile, float exposure, float* pixels,
+    axial_kernel(AxialMarchScene scene, Camera camera, LaunchTile first, float exposure, float* pixels,
                  unsigned long long* clamps) {
-  // The tiles around first_tile first (core/launch_order.h).
-  const int x = centre_out(int(blockIdx.x), first_tile.x, int(gridDim.x)) * blockDim.x + threadIdx.x;
-  const int y = centre_out(int(blockIdx.y), first_tile.y, int(gridDim.y)) * blockDim.y + threadIdx.y;
+  // The tiles around the first tile first (core/launch_order.h).
+  const int x = centre_out(int(blockIdx.x), first.x, int(gridDim.x)) * blockDim.x + threadIdx.x;
+  const int y = centre_out(int(blockIdx.y), first.y, int(gridDim.y)) * blockDim.y + threadIdx.y;
   if (x >= camera.width || y >= camera.height) return;
   Vec3 origin, dir;
   if (!camera.ray(x, y, origin, dir)) return;
@@ -82,15 +81,7 @@ Image render_axial_cuda(const AxialRenderInputs& in, AxialRenderStats* stats) {
 #endif
   constexpr int bx = NEBULA_AXIAL_BLOCK_X, by = 128 / bx;
   const dim3 block(bx, by), grid((in.camera.width + bx - 1) / bx, (in.camera.height + by - 1) / by);
-  // The tile holding the first star's image (its rays shade the most), else the image's centre.
-  float cx = 0.5f * float(in.camera.width), cy = 0.5f * float(in.camera.height);
-  if (!in.stars.empty())
-    if (const std::optional<ImagePoint> at = project_point(in.camera, in.stars[0].position);
-        at && at->x >= 0.0 && at->x < in.camera.width && at->y >= 0.0 && at->y < in.camera.height) {
-      cx = float(at->x);
-      cy = float(at->y);
-    }
-  const int2 first_tile{int(cx) / bx, int(cy) / by};
+  const LaunchTile first = first_tile(in.camera, star_positions(in.stars), bx, by);  // core/launch_order.h
   int rays = 0;
   const std::vector<StarPixel> list =
       scene.n_stars > 0 && in.star_pixels ? star_pixels(in.camera, star_positions(in.stars), &rays)
@@ -115,7 +106,7 @@ Image render_axial_cuda(const AxialRenderInputs& in, AxialRenderStats* stats) {
       }
     }
     axial_kernel<kMode, decltype(has_stars)::value, kField, kDeform>
-        <<<grid, block>>>(scene, in.camera, first_tile, in.exposure, pixels.get(), clamps.get());
+        <<<grid, block>>>(scene, in.camera, first, in.exposure, pixels.get(), clamps.get());
     if (!list.empty()) {
       star_pixel_stream.join();
       store_star_pixels_cuda(device_list->get(), int(list.size()), sub->get(), rays, scene.n_bands, in.exposure,

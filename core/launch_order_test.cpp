@@ -36,5 +36,32 @@ TEST(CentreOut, StartsAtTheCentreAndMovesOut) {
   EXPECT_EQ(centre_out(2, 5, n), 6);
 }
 
+// The tile of the first point's image, else of the image's centre.
+TEST(FirstTile, HoldsTheFirstStarsImageElseTheCentre) {
+  CameraSettings s;
+  s.position = {0, 0, -10};
+  s.look_at = {0, 0, 0};
+  s.up = {0, 1, 0};
+  s.fov_deg = 60;
+  s.width = 160;
+  s.height = 96;
+  const Camera c = make_camera(s);
+  const LaunchTile centre = first_tile(c, {}, 16, 8);
+  EXPECT_EQ(centre.x, 5);  // pixel (80, 48)
+  EXPECT_EQ(centre.y, 6);
+  // A star straight ahead images at the centre; one behind the camera has no image.
+  const LaunchTile ahead = first_tile(c, {Vec3{0, 0, 0}, Vec3{1, 1, 0}}, 16, 8);
+  EXPECT_EQ(ahead.x, centre.x);
+  EXPECT_EQ(ahead.y, centre.y);
+  const LaunchTile behind = first_tile(c, {Vec3{0, 0, -20}}, 16, 8);
+  EXPECT_EQ(behind.x, centre.x);
+  EXPECT_EQ(behind.y, centre.y);
+  // Up and to the camera's right (-x here): the first row of tiles, the right half.
+  const LaunchTile corner = first_tile(c, {Vec3{-4, 5, 0}}, 16, 8);
+  EXPECT_EQ(corner.y, 0);
+  EXPECT_GT(corner.x, centre.x);
+  EXPECT_LT(corner.x, 10);
+}
+
 }  // namespace
 }  // namespace nebula
