@@ -81,10 +81,11 @@ Image render_axial_cuda(const AxialRenderInputs& in, AxialRenderStats* stats) {
 #endif
   constexpr int bx = NEBULA_AXIAL_BLOCK_X, by = 128 / bx;
   const dim3 block(bx, by), grid((in.camera.width + bx - 1) / bx, (in.camera.height + by - 1) / by);
-  const LaunchTile first = first_tile(in.camera, star_positions(in.stars), bx, by);  // core/launch_order.h
+  const std::vector<Vec3> stars = star_positions(in.stars);
+  const LaunchTile first = first_tile(in.camera, stars, bx, by);  // core/launch_order.h
   int rays = 0;
   const std::vector<StarPixel> list =
-      scene.n_stars > 0 && in.star_pixels ? star_pixels(in.camera, star_positions(in.stars), &rays)
+      scene.n_stars > 0 && in.star_pixels ? star_pixels(in.camera, stars, &rays)
                                           : std::vector<StarPixel>{};
   std::unique_ptr<DeviceArray<StarPixel>> device_list;
   std::unique_ptr<DeviceArray<float>> sub;
