@@ -5,9 +5,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include "core/gpu.h"
 #include "axial/axial_diffuse.h"
 #include "axial/axial_test_scenes.h"
+#include "core/test_support.h"
 
 namespace nebula {
 namespace {
@@ -43,8 +43,7 @@ Difference compare(const Image& a, const Image& ref) {
 // at most 1% of the pixels may differ by more than 1e-4 of the peak, the mean
 // difference must stay below 1e-4 of the peak and none may exceed 1/4 of it.
 TEST(AxialRendererGpu, SkippingModesMatchNaiveAndTheCpu) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   for (const std::string& name : synthetic_axial_map_names()) {
     AxialScene s(name, 96, 40);
     s.inputs.star_pixels = true;  // the star pixels' rays on both backends too
@@ -87,8 +86,7 @@ TEST(AxialRendererGpu, SkippingModesMatchNaiveAndTheCpu) {
 // every skipping mode matches its naive march (1e-6 of the peak, printed when
 // not bit-identical).
 TEST(AxialRendererGpu, DeformedMarchMatchesTheCpu) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   const NoiseKind kinds[] = {NoiseKind::Simplex, NoiseKind::Fbm, NoiseKind::Turbulence, NoiseKind::Cellular};
   for (const std::string& name : synthetic_axial_map_names()) {
     AxialScene s(name, 96, 40);
@@ -138,8 +136,7 @@ TEST(AxialRendererGpu, DeformedMarchMatchesTheCpu) {
 // with it follows the CPU's with the bounds above, in the skipping modes.
 // With zonal degrees (to 24 above degree 3) as without.
 TEST(AxialRendererGpu, DiffuseFieldMatchesTheCpu) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   for (const int zonal : {0, 24})
   for (const std::string name : {"cloud", "bipolar"}) {
     AxialScene s(name, 96, 40, normalize(Vec3{1, 2, 3}), 50.0f, 1.0f);
@@ -198,8 +195,7 @@ TEST(AxialRendererGpu, DiffuseFieldMatchesTheCpu) {
 // crosses may move by 4 L 2^-24 (FMA contraction) and hand that much of the
 // densest texel's depth to its neighbour, plus 1e-5 relative.
 TEST(AxialRendererGpu, BakeAgreesWithTheCpu) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   const AxialMap m = synthetic_axial_map("cloud", 128, 64, 0.01f, 0, 3.0f);
   float densest = 0;
   for (float v : m.tau_v) densest = std::max(densest, v);

@@ -12,18 +12,12 @@
 #include <string>
 #include <vector>
 
-#include "core/gpu.h"
 #include "core/math.h"
 #include "core/math_gpu.h"
+#include "core/test_support.h"
 
 namespace nebula {
 namespace {
-
-#define SKIP_WITHOUT_GPU()                               \
-  do {                                                   \
-    std::string reason;                                  \
-    if (!gpu_available(&reason)) GTEST_SKIP() << reason; \
-  } while (0)
 
 // The error in ulps as the CUDA guide counts it: the number of floats between
 // the result and the correctly rounded one (same sign, finite).
@@ -54,7 +48,7 @@ TEST(FastMathHost, IsTheLibrarysFunctions) {
 }
 
 TEST(FastMathGpu, ReciprocalWithinTwoUlp) {
-  SKIP_WITHOUT_GPU();
+  NEBULA_SKIP_WITHOUT_GPU();
   std::vector<float> x = log_uniform(1e-30f, 1e30f, 200000, 1);
   for (size_t i = 0; i < x.size(); i += 2) x[i] = -x[i];
   const std::vector<float> y = fast_math_gpu(FastMath::Reciprocal, x);
@@ -65,7 +59,7 @@ TEST(FastMathGpu, ReciprocalWithinTwoUlp) {
 }
 
 TEST(FastMathGpu, ReciprocalSqrtWithinTwoUlp) {
-  SKIP_WITHOUT_GPU();
+  NEBULA_SKIP_WITHOUT_GPU();
   const std::vector<float> x = log_uniform(1e-30f, 1e30f, 200000, 2);
   const std::vector<float> y = fast_math_gpu(FastMath::ReciprocalSqrt, x);
   double worst = 0;
@@ -75,7 +69,7 @@ TEST(FastMathGpu, ReciprocalSqrtWithinTwoUlp) {
 }
 
 TEST(FastMathGpu, ExpWithinItsBoundAndExactAtZero) {
-  SKIP_WITHOUT_GPU();
+  NEBULA_SKIP_WITHOUT_GPU();
   // Attenuations e^-tau with results above the smallest normal float (tau < 87).
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> tau(0.0f, 87.0f);

@@ -13,6 +13,17 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/gpu.h"
+
+// Skips the current test, saying why, where no CUDA device can run our kernels
+// (CI, the development machine); GPU tests carry the ctest label "gpu" and run
+// on a machine with one. A statement: NEBULA_SKIP_WITHOUT_GPU();
+#define NEBULA_SKIP_WITHOUT_GPU()                                \
+  do {                                                           \
+    std::string nebula_no_gpu_reason;                            \
+    if (!::nebula::gpu_available(&nebula_no_gpu_reason))         \
+      GTEST_SKIP() << "no usable GPU: " << nebula_no_gpu_reason; \
+  } while (0)
 
 namespace nebula::testing {
 

@@ -5,8 +5,8 @@
 
 #include <cmath>
 
-#include "core/gpu.h"
 #include "core/philox.h"
+#include "core/test_support.h"
 #include "diffuse/diffuse_bake.h"
 #include "montecarlo/henyey_greenstein.h"
 
@@ -35,8 +35,7 @@ ScatteringTable thin_table(double g) {
 }
 
 TEST(DiffuseBakeGpu, AgreesWithTheCpuWithinAFractionOfItsNoise) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   const DensityGrid grid = random_cube(24, 0.3f, 9);
   const ScatteringTable table = thin_table(0.6);
   std::vector<DiffuseBand> bands(2);
@@ -82,8 +81,7 @@ TEST(DiffuseBakeGpu, AgreesWithTheCpuWithinAFractionOfItsNoise) {
 // A sweep's albedos from one pass: every slot's field on the GPU against the
 // CPU's, and the largest albedo's slot equal to a bake of its own on the GPU.
 TEST(DiffuseBakeGpu, SharedAlbedosAgreeWithTheCpu) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   const DensityGrid grid = random_cube(20, 0.4f, 5);
   const ScatteringTable table = thin_table(0.3);
   auto bands = [&](float albedo) {

@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "core/gpu.h"
 #include "core/philox.h"
+#include "core/test_support.h"
 #include "illumination/optical_depth_bake.h"
 
 namespace nebula {
@@ -16,8 +16,7 @@ namespace {
 // neighbour. The bound sums that over every boundary (nx + ny + nz at most),
 // plus 1e-5 relative for the summation itself.
 TEST(OpticalDepthBakeGpu, AgreesWithTheCpu) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   DensityGrid grid;
   grid.shape.nx = 40;
   grid.shape.ny = 33;

@@ -4,19 +4,13 @@
 
 #include <cmath>
 
-#include "core/gpu.h"
+#include "core/test_support.h"
 #include "montecarlo/slab.h"
 #include "montecarlo/tabulate.h"
 #include "montecarlo/test_stats.h"
 
 namespace nebula {
 namespace {
-
-#define REQUIRE_GPU()                              \
-  do {                                             \
-    std::string why;                               \
-    if (!gpu_available(&why)) GTEST_SKIP() << why; \
-  } while (0)
 
 TabulateParams gpu_params() {
   TabulateParams p;
@@ -28,7 +22,7 @@ TabulateParams gpu_params() {
 }
 
 TEST(Gpu, TableAgreesWithCpuWithinFourStandardErrors) {
-  REQUIRE_GPU();
+  NEBULA_SKIP_WITHOUT_GPU();
   for (AngularBinning binning : {AngularBinning::UniformMu, AngularBinning::UniformTheta}) {
     TabulateParams p = gpu_params();
     p.binning = binning;
@@ -57,7 +51,7 @@ TEST(Gpu, TableAgreesWithCpuWithinFourStandardErrors) {
 }
 
 TEST(Gpu, RunToRunIdentical) {
-  REQUIRE_GPU();
+  NEBULA_SKIP_WITHOUT_GPU();
   const TabulateParams p = gpu_params();
   const Tabulation a = tabulate(p, Backend::Cuda);
   const Tabulation b = tabulate(p, Backend::Cuda);
@@ -66,7 +60,7 @@ TEST(Gpu, RunToRunIdentical) {
 }
 
 TEST(Gpu, ConservesEnergyAtAlbedoOne) {
-  REQUIRE_GPU();
+  NEBULA_SKIP_WITHOUT_GPU();
   TabulateParams p = gpu_params();
   p.albedo = 1.0;
   const Tabulation t = tabulate(p, Backend::Cuda);
@@ -75,7 +69,7 @@ TEST(Gpu, ConservesEnergyAtAlbedoOne) {
 }
 
 TEST(Gpu, SlabMatchesVanDeHulstAndTheCpu) {
-  REQUIRE_GPU();
+  NEBULA_SKIP_WITHOUT_GPU();
   SlabParams p;
   p.albedo = 0.9;
   p.g = 0.75;

@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "core/gpu.h"
 #include "core/philox.h"
+#include "core/test_support.h"
 #include "multires/pyramid_render.h"
 #include "raycast/test_scenes.h"
 
@@ -14,8 +14,7 @@ namespace {
 // (the combination's per-pixel steps are multires/pyramid_pixels.h on both). Levels add up, so the tolerance is the exact
 // mode's 1e-4 of the peak per level.
 TEST(PyramidGpu, AgreesWithTheCpu) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   testing::OneStarScene s;
   s.grid = testing::noise_cube(40, 0.3f, 5);  // 40 -> 20 -> 10 -> 5: odd at the last level
   s.table = testing::thin_table(0.6, 72, 10.0);

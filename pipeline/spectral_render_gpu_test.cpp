@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "core/gpu.h"
+#include "core/test_support.h"
 #include "pipeline/run_setup.h"
 #include "pipeline/scene_bands.h"
 #include "pipeline/spectral_scene.h"
@@ -48,8 +48,7 @@ double worst_of_peak(const Image& a, const Image& b) {
 // by both renderers: the CPU's downloads it. Accumulators agree to 1e-4 of
 // their peak, as the renderers do on the same inputs (spectral_renderer_gpu_test).
 TEST_F(SpectralSceneGpu, DeviceLightMarchedByBothBackends) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   const Scene s = scene();
   const SceneBands bands = scene_bands(s);
   std::vector<std::pair<std::string, Passband>> filters;
@@ -81,8 +80,7 @@ TEST_F(SpectralSceneGpu, DeviceLightMarchedByBothBackends) {
 // The whole render on each backend: the fields' photons are the same on both
 // (fixed-point sums), so the images agree far within the fields' noise.
 TEST_F(SpectralSceneGpu, RenderAgreesWithTheCpu) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   const Scene s = scene();
   RenderOptions cpu_options, gpu_options;
   gpu_options.backend = Backend::Cuda;

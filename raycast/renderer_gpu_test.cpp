@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "core/gpu.h"
 #include "core/philox.h"
+#include "core/test_support.h"
 #include "diffuse/diffuse_bake.h"
 #include "raycast/renderer.h"
 #include "raycast/test_scenes.h"
@@ -14,8 +14,7 @@ namespace {
 // The same march_ray on both backends; float contraction on the GPU moves
 // voxel-boundary crossings by ulps, so images agree to 1e-4 of the peak.
 TEST(RendererGpu, AgreesWithTheCpu) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   testing::OneStarScene s;
   s.grid = testing::noise_cube(48, 0.4f, 3);
   s.table = testing::thin_table(0.6, 72, 10.0);
@@ -58,8 +57,7 @@ TEST(RendererGpu, AgreesWithTheCpu) {
 // With a diffuse field: the same marcher on both backends (the field's lookups
 // and the delta-M peak's transmittance included).
 TEST(RendererGpu, DiffuseFieldAgreesWithTheCpu) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   testing::OneStarScene s;
   s.grid = testing::noise_cube(40, 0.4f, 11);
   s.table = testing::thin_table(0.6, 72, 10.0);

@@ -8,7 +8,7 @@
 #include <cstdio>
 
 #include "axial/axial_renderer.h"
-#include "core/gpu.h"
+#include "core/test_support.h"
 #include "reconstruct/projection.h"
 #include "reconstruct/reconstruct.h"
 
@@ -38,8 +38,7 @@ double relative(const std::vector<float>& a, const std::vector<float>& ref) {
 }
 
 TEST(ReconstructGpu, ProjectionMatchesTheCpu) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   const int n = 96;
   const float step = 0.5f;
   const ColumnProjection cpu = build_projection(n, step, Backend::Cpu);
@@ -69,8 +68,7 @@ TEST(ReconstructGpu, ProjectionMatchesTheCpu) {
 }
 
 TEST(ReconstructGpu, PowellOnTheGpuReachesTheCpusError) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   AxialMap m = synthetic_axial_map("lopsided", 64, 48, 1.0f, 3);
   m.origin = {0, 0, 0};
   m.axis = {1, 0, 0};

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "core/gpu.h"
+#include "core/test_support.h"
 #include "spectral/spectral_test_scene.h"
 #include "tables/test_tables.h"
 
@@ -26,8 +26,7 @@ double largest_difference(const Image& cpu, const Image& gpu) {
 // accumulators agree to 1e-4 of
 // their peak (float contraction moves voxel crossings by ulps).
 TEST(SpectralRendererGpu, AgreesWithTheCpu) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   auto scene = testing::noise_scene(24, 0.6f, {{0.1f, 0.2f, -0.1f}, {-0.3f, 0.0f, 0.2f}}, 64, 48);
   const auto f = testing::filters({"B", "V", "R"});
   const ScatteringTable table = nebula::testing::make_test_table(5.0, 501, AngularBinning::UniformTheta, 90, 0.6);
@@ -56,8 +55,7 @@ TEST(SpectralRendererGpu, AgreesWithTheCpu) {
 // the same terms (a TBB loop on the CPU, a kernel on the GPU) in the same march, every method,
 // the voxel-light pre-pass included; accumulators agree to 1e-4 of their peak.
 TEST(SpectralRendererGpu, LightBetweenVoxelsAgreesWithTheCpu) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   auto scene = testing::noise_scene(24, 0.6f, {{0.1f, 0.2f, -0.1f}, {-0.3f, 0.0f, 0.2f}}, 64, 48);
   const auto f = testing::filters({"B", "V", "R"});
   const ScatteringTable table = nebula::testing::make_test_table(5.0, 501, AngularBinning::UniformTheta, 90, 0.6);
@@ -83,8 +81,7 @@ TEST(SpectralRendererGpu, LightBetweenVoxelsAgreesWithTheCpu) {
 // the thin-voxel limit (the double integral taking them per wavelength too) and
 // through node tables; accumulators agree to 1e-4 of their peak.
 TEST(SpectralRendererGpu, VaryingAlbedoAndGAgreeWithTheCpu) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   auto scene = testing::noise_scene(20, 0.6f, {{0.1f, 0.2f, -0.1f}, {-0.3f, 0.0f, 0.2f}}, 48, 40);
   const auto f = testing::filters({"B", "V", "R"});
   for (SpectralMethod method : {SpectralMethod::Double, SpectralMethod::Projection, SpectralMethod::LightBasis,
@@ -116,8 +113,7 @@ TEST(SpectralRendererGpu, VaryingAlbedoAndGAgreeWithTheCpu) {
 // Emission (a line and a continuum, one weighted by a grid, one by tau_V)
 // with two stars: the resolved images agree to 1e-4 of each filter's peak.
 TEST(SpectralRendererGpu, EmissionAgreesWithTheCpu) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   auto scene = testing::noise_scene(20, 0.6f, {{0.1f, 0.2f, -0.1f}, {-0.3f, 0.0f, 0.2f}}, 48, 40);
   std::vector<float> weight(scene.grid.tau_v.size());
   for (size_t i = 0; i < weight.size(); ++i) weight[i] = 0.1f * float(i % 5);

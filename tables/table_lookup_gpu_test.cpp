@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "core/gpu.h"
+#include "core/test_support.h"
 #include "tables/table_lookup_gpu.h"
 #include "tables/table_lookup.h"
 #include "tables/test_tables.h"
@@ -18,12 +19,6 @@ namespace nebula {
 namespace {
 
 using testing::make_test_table;
-
-#define SKIP_WITHOUT_GPU()                             \
-  do {                                                 \
-    std::string reason;                                \
-    if (!gpu_available(&reason)) GTEST_SKIP() << reason; \
-  } while (0)
 
 // Random points over and beyond the table, plus every special value.
 void make_points(float tau_max, std::vector<float>& tau, std::vector<float>& mu) {
@@ -45,7 +40,7 @@ void make_points(float tau_max, std::vector<float>& tau, std::vector<float>& mu)
 }
 
 TEST(TableLookupGpu, AgreesWithTheHost) {
-  SKIP_WITHOUT_GPU();
+  NEBULA_SKIP_WITHOUT_GPU();
   for (AngularBinning binning : {AngularBinning::UniformMu, AngularBinning::UniformTheta}) {
     const ScatteringTable t = make_test_table(20.0, 201, binning, 72, 0.8);
     const TableView host = view_of(t);
@@ -99,7 +94,7 @@ TEST(TableLookupGpu, AgreesWithTheHost) {
 }
 
 TEST(TableLookupGpu, MismatchedInputsAreRefused) {
-  SKIP_WITHOUT_GPU();
+  NEBULA_SKIP_WITHOUT_GPU();
   const ScatteringTable t = make_test_table();
   EXPECT_THROW(lookup_batch_gpu(t, {1.0f, 2.0f}, {0.5f}, nullptr), Error);
   EXPECT_TRUE(lookup_batch_gpu(t, {}, {}, nullptr).empty());

@@ -5,8 +5,8 @@
 
 #include <cstdio>
 
-#include "core/gpu.h"
 #include "core/philox.h"
+#include "core/test_support.h"
 #include "raycast/test_scenes.h"
 #include "validation/image_compare.h"
 #include "truth/truth_renderer.h"
@@ -15,8 +15,7 @@ namespace nebula {
 namespace {
 
 void expect_cpu_and_cuda_agree(bool equiangular) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << "no usable GPU: " << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   DensityGrid g = testing::cube(24, 1.0f);
   for (size_t i = 0; i < g.tau_v.size(); ++i) {
     const float u = philox_uniform4(5, 0, uint32_t(i), 3, 0).u0;
@@ -59,8 +58,7 @@ void expect_cpu_and_cuda_agree(bool equiangular) {
 // same samples, so the image equals the one-thread-per-pixel launch's to the
 // rounding of the double sums' order, whatever the number of shares.
 TEST(TruthGpu, SharingAPixelsSamplesAmongThreadsChangesNoSample) {
-  std::string why;
-  if (!gpu_available(&why)) GTEST_SKIP() << "no usable GPU: " << why;
+  NEBULA_SKIP_WITHOUT_GPU();
   DensityGrid g = testing::cube(16, 1.0f);
   for (size_t i = 0; i < g.tau_v.size(); ++i) g.tau_v[i] = 0.4f * philox_uniform4(9, 0, uint32_t(i), 3, 0).u0;
   TruthInputs in;
