@@ -78,6 +78,7 @@ std::vector<RenderSession::PlannedPoint> RenderSession::plan(const std::vector<s
   std::vector<std::vector<Candidate>> candidates;
   for (size_t i = 0; i < points.size(); ++i) {
     std::unique_ptr<Scene> scene = load_detached(points[i]);
+    if (scene->spectral) continue;  // the spectral renderer bakes its fields at its own nodes
     SceneBands bands = scene_bands(*scene);
     DiffuseKeys keys = diffuse_keys(*scene, bands, options_);
     if (keys.photons.empty()) continue;
@@ -147,7 +148,7 @@ RenderOutput RenderSession::render(const std::vector<std::string>& overrides) {
   const auto start = std::chrono::steady_clock::now();
   const Scene& scene = load(overrides);
   RenderOutput out;
-  if (scene.axial) {
+  if (scene.axial || scene.spectral) {  // their own renderers, whole each time (render_scene)
     prepared_.reset();
     retired_.reset();
     out = render_scene(scene, options_);

@@ -33,55 +33,75 @@ spectral::SpectralMethod method_of(const std::string& name) {
 
 }  // namespace
 
+namespace {
+
 // One band per table node: its attenuation kappa_m, the dust's albedo, g and
-// table, the star's power L s(lambda_m) at a wavelength where kappa(lambda_m) =
-// kappa_m (spectral_scene.h).
-spectral::SpectralDiffuseLight spectral_diffuse_light(const Scene& scene, const spectral::SpectralModel& model,
-                                                      const std::vector<const ScatteringTable*>& tables,
-                                                      BakeResult& bake,
-                                                      const Camera& camera, const RenderOptions& o,
-                                                      RunReport& report, double* view_seconds) {
-  const int n = int(model.node_kappa.size());
-  std::vector<DiffuseBand> bands(static_cast<size_t>(n));
-  std::vector<RenderBand> render_bands(static_cast<size_t>(n));
-  std::vector<double> lambda(static_cast<size_t>(n));
-  for (int m = 0; m < n; ++m) {
-    DiffuseBand& b = bands[size_t(m)];
+// table (the node's own when albedo and g vary with wavelength), and the
+// wavelength where kappa(lambda_m) = kappa_m.
+struct NodeBands {
+  std::vector<DiffuseBand> bands;
+  std::vector<RenderBand> render_bands;
+  std::vector<double> lambda;
+};
+NodeBands node_bands(const Scene& scene, const spectral::SpectralModel& model,
+                     const std::vector<const ScatteringTable*>& tables) {
+  const size_t n = model.node_kappa.size();
+  NodeBands out;
+  out.bands.resize(n);
+  out.render_bands.resize(n);
+  for (size_t m = 0; m < n; ++m) {
+    DiffuseBand& b = out.bands[m];
     char name[32];
-    std::snprintf(name, sizeof name, "kappa %.3g", model.node_kappa[size_t(m)]);
+    std::snprintf(name, sizeof name, "kappa %.3g", model.node_kappa[m]);
     b.name = name;
-    b.extinction_ratio = float(model.node_kappa[size_t(m)]);
-    // The node's own albedo and g when they vary with wavelength, its table for them.
-    b.albedo = float(model.varying() ? model.node_albedo[size_t(m)] : scene.dust.albedo.front());
-    b.g = float(model.varying() ? model.node_g[size_t(m)] : scene.dust.g.front());
-    b.table = tables[size_t(m)];
-    static_cast<Band&>(render_bands[size_t(m)]) = b;
-    render_bands[size_t(m)].table = b.table;
-    lambda[size_t(m)] = model.wavelength_of_kappa(model.node_kappa[size_t(m)]);
+    b.extinction_ratio = float(model.node_kappa[m]);
+    b.albedo = float(model.varying() ? model.node_albedo[m] : scene.dust.albedo.front());
+    b.g = float(model.varying() ? model.node_g[m] : scene.dust.g.front());
+    b.table = tables[m];
+    static_cast<Band&>(out.render_bands[m]) = b;
+    out.render_bands[m].table = b.table;
+    out.lambda.push_back(model.wavelength_of_kappa(model.node_kappa[m]));
   }
+  return out;
+}
+
+// Star k as the band renderer's bakes and passes take it: its depth bake
+// (with the CUDA copy when one is kept) and its power at each node.
+BakedStar node_star(const Scene& scene, BakeResult& bake, size_t k, const std::vector<double>& power) {
+  BakedStar star;
+  star.position = scene.stars[k].position;
+  star.depth_v = &bake.tau_v[k];
+  if (k < bake.device_tau_v.size()) star.depth_mirror = &bake.device_tau_v[k];  // uploaded once, not per pass
+  for (double p : power) star.power.push_back(float(p));
+  return star;
+}
+
+}  // namespace
+
+SpectralDiffuseFields bake_spectral_diffuse(const Scene& scene, const spectral::SpectralModel& model,
+                                            const std::vector<const ScatteringTable*>& tables, BakeResult& bake,
+                                            const RenderOptions& o, RunReport& report) {
+  const NodeBands nodes = node_bands(scene, model, tables);
   DiffuseBakeOptions options = diffuse_options(scene);
   options.common_streams = true;  // the nodes' fields differ by their attenuation more than by their noise
-  spectral::SpectralDiffuseLight out;
-  *view_seconds = 0;
+  SpectralDiffuseFields out;
+  out.render_bands = nodes.render_bands;
   for (size_t k = 0; k < scene.stars.size(); ++k) {
     const auto t0 = std::chrono::steady_clock::now();
-    BakedStar star;
-    star.position = scene.stars[k].position;
-    star.depth_v = &bake.tau_v[k];
-    if (k < bake.device_tau_v.size()) star.depth_mirror = &bake.device_tau_v[k];  // uploaded once, not per pass
     std::vector<double> power;
-    for (int m = 0; m < n; ++m)  // L_sun um^-1
-      power.push_back(scene.stars[k].luminosity_lsun * model.stars[k].shape(lambda[size_t(m)]));
-    for (double p : power) star.power.push_back(float(p));
+    for (double lambda : nodes.lambda)  // L_sun um^-1
+      power.push_back(scene.stars[k].luminosity_lsun * model.stars[k].shape(lambda));
     out.node_power.push_back(power);
     DiffuseBakeStats stats;
-    std::unique_ptr<Progress> bar = diffuse_progress(bands, options, o);
-    const DiffuseField field = bake_diffuse(scene.density, bands, {star}, options, o.backend, &stats, bar.get());
+    std::unique_ptr<Progress> bar = diffuse_progress(nodes.bands, options, o);
+    out.fields.push_back(
+        bake_diffuse(scene.density, nodes.bands, {node_star(scene, bake, k, power)}, options, o.backend, &stats, bar.get()));
     bar.reset();
-    const DiffuseReport r = diffuse_report(bands, options, field, 1 << field.shift, stats, seconds_since(t0));
+    const DiffuseField& field = out.fields.back();
+    const DiffuseReport r = diffuse_report(nodes.bands, options, field, 1 << field.shift, stats, seconds_since(t0));
     if (k == 0) {
       report.diffuse = r;
-      for (const DiffuseBand& b : bands) report.diffuse.names.push_back(b.name);
+      for (const DiffuseBand& b : nodes.bands) report.diffuse.names.push_back(b.name);
     } else {  // the stars' bakes together; noise and memory: the first star's (each star's field is baked alone)
       report.diffuse.seconds += r.seconds;
       report.diffuse.wall_seconds += r.wall_seconds;
@@ -89,15 +109,27 @@ spectral::SpectralDiffuseLight spectral_diffuse_light(const Scene& scene, const 
       report.diffuse.crossings += r.crossings;
       report.diffuse.capped += r.capped;
     }
+  }
+  report.diffuse.stars = scene.stars.size();
+  return out;
+}
+
+spectral::SpectralDiffuseLight spectral_diffuse_view(const Scene& scene, const SpectralDiffuseFields& fields,
+                                                     BakeResult& bake, const Camera& camera, Backend backend,
+                                                     double* view_seconds) {
+  spectral::SpectralDiffuseLight out;
+  out.node_power = fields.node_power;
+  *view_seconds = 0;
+  for (size_t k = 0; k < fields.fields.size(); ++k) {
     const auto t_view = std::chrono::steady_clock::now();
     RenderInputs view;
     view.density = &scene.density;
-    view.bands = render_bands;
-    view.stars = {star};
-    view.diffuse = &field;
+    view.bands = fields.render_bands;
+    view.stars = {node_star(scene, bake, k, fields.node_power[k])};
+    view.diffuse = &fields.fields[k];
     view.camera = camera;
-    DiffuseLightArrays arrays = diffuse_light_arrays(view, o.backend);
-    if (o.backend == Backend::Cuda) {  // left on the device, where the CUDA renderer reads them
+    DiffuseLightArrays arrays = diffuse_light_arrays(view, backend);
+    if (backend == Backend::Cuda) {  // left on the device, where the CUDA renderer reads them
       out.device_light.push_back(std::move(arrays.device_light));
       if (k == 0) out.device_peak = std::move(arrays.device_peak);
     } else {
@@ -106,8 +138,15 @@ spectral::SpectralDiffuseLight spectral_diffuse_light(const Scene& scene, const 
     }
     *view_seconds += seconds_since(t_view);
   }
-  report.diffuse.stars = scene.stars.size();
   return out;
+}
+
+spectral::SpectralDiffuseLight spectral_diffuse_light(const Scene& scene, const spectral::SpectralModel& model,
+                                                      const std::vector<const ScatteringTable*>& tables,
+                                                      BakeResult& bake, const Camera& camera, const RenderOptions& o,
+                                                      RunReport& report, double* view_seconds) {
+  const SpectralDiffuseFields fields = bake_spectral_diffuse(scene, model, tables, bake, o, report);
+  return spectral_diffuse_view(scene, fields, bake, camera, o.backend, view_seconds);
 }
 
 spectral::SpectralSettings spectral_settings(const Scene& scene) {
@@ -135,12 +174,18 @@ spectral::SpectralSettings spectral_settings(const Scene& scene) {
   return s;
 }
 
-RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
+std::shared_ptr<const PreparedSpectral> prepare_spectral(const Scene& scene, const RenderOptions& o) {
   if (!scene.spectral) throw Error(scene.path + ": spectral: the scene has no [spectral] table");
   validate_scene(scene);
   check_run_memory(scene, RunKind::Fast);
-  const SceneBands bands = scene_bands(scene);
-  RunReport report = begin_report(scene, bands, "spectral", o.backend);
+  auto prepared = std::make_shared<PreparedSpectral>();
+  PreparedSpectral& p = *prepared;
+  p.scene = &scene;
+  p.options = o;
+  p.bands = scene_bands(scene);
+  const SceneBands& bands = p.bands;
+  RunReport& report = p.report;
+  report = begin_report(scene, bands, "spectral", o.backend);
   report.mode = "spectral " + scene.spectral->method;
   report.multiple_scattering = "none";
 
@@ -230,39 +275,55 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
   // One V-band depth bake per star (the spectral march scales it by kappa(lambda)).
   std::vector<Vec3> positions;
   for (const SceneStar& s : scene.stars) positions.push_back(s.position);
-  BakeResult bake;
+  p.bake = std::make_shared<BakeResult>();
   if (!positions.empty()) {
     const auto t0 = std::chrono::steady_clock::now();
-    bake = bake_star_depths(scene.density, positions, o.backend);
+    *p.bake = bake_star_depths(scene.density, positions, o.backend);
     report.bake = {true, positions.size(), scene.density.shape.count(), seconds_since(t0)};
   }
+  if (diffuse) p.diffuse = bake_spectral_diffuse(scene, model, read_tables, *p.bake, o, report);
+  p.table = table;
+  p.node_tables = node_tables;
+  p.table_nodes = settings.table_nodes;
+  p.tables = tables;
+  p.emission_components = int(emission.size());
+  report.spectral = sr;
+  p.model = std::move(model);
+  return prepared;
+}
 
+RenderOutput render_prepared_spectral(const PreparedSpectral& p, const CameraSettings& camera) {
+  const Scene& scene = *p.scene;
+  const SceneBands& bands = p.bands;
+  RunReport report = p.report;
+  SpectralReport sr = *report.spectral;
   spectral::SpectralRenderInputs in;
   in.density = &scene.density;
-  in.model = &model;
+  in.model = &p.model;
   for (size_t k = 0; k < scene.stars.size(); ++k)
-    in.lights.push_back({scene.stars[k].position, scene.stars[k].luminosity_lsun, &bake.tau_v[k]});
+    in.lights.push_back({scene.stars[k].position, scene.stars[k].luminosity_lsun, &p.bake->tau_v[k]});
   in.albedo = float(scene.dust.albedo.front());
   in.g = float(scene.dust.g.front());
-  in.table = table.get();
-  for (const auto& t : node_tables) in.node_tables.push_back(t.get());
-  for (size_t c = 0; c < emission.size(); ++c) {
+  in.table = p.table.get();
+  for (const auto& t : p.node_tables) in.node_tables.push_back(t.get());
+  for (int c = 0; c < p.emission_components; ++c) {
     const auto& grids = scene.spectral->emission_grids;  // scale applied; none: the voxel's tau_V times scale
-    const std::vector<float>* grid = c < grids.size() && !grids[c].empty() ? &grids[c] : nullptr;
-    in.emission.push_back({grid, grid ? 1.0f : float(scene.spectral->emission[c].scale)});
+    const std::vector<float>* grid = size_t(c) < grids.size() && !grids[size_t(c)].empty() ? &grids[size_t(c)] : nullptr;
+    in.emission.push_back({grid, grid ? 1.0f : float(scene.spectral->emission[size_t(c)].scale)});
   }
-  in.camera = make_camera(scene.camera);
+  in.camera = make_camera(camera);
   in.star_pixels = scene.star_pixels;
   spectral::SpectralDiffuseLight diffuse_light;
+  const bool diffuse = p.diffuse.has_value();
   if (diffuse) {
-    diffuse_light = spectral_diffuse_light(scene, model, read_tables, bake, in.camera, o, report, &sr.diffuse_view_seconds);
+    diffuse_light = spectral_diffuse_view(scene, *p.diffuse, *p.bake, in.camera, p.options.backend, &sr.diffuse_view_seconds);
     in.diffuse = &diffuse_light;
   }
   double march_seconds = 0;
-  const Image acc = spectral::render_spectral(in, o.backend, &march_seconds);
+  const Image acc = spectral::render_spectral(in, p.options.backend, &march_seconds);
   const auto t_resolve = std::chrono::steady_clock::now();
   RenderOutput out;
-  out.image = spectral::resolve_filters(acc, model);
+  out.image = spectral::resolve_filters(acc, p.model);
   sr.resolve_seconds = seconds_since(t_resolve);
   report.render_seconds = march_seconds;
   if (in.star_pixels && !in.lights.empty()) {
@@ -274,17 +335,17 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
   draw_scene_stars(scene, bands, in.camera, 1.0, out.image);
 
   out.report = report;
-  out.metadata = scene_metadata(scene, bands, scene.camera, report.mode);
+  out.metadata = scene_metadata(scene, bands, camera, report.mode);
   report.multiple_scattering = diffuse ? "diffuse" : "none";
   out.report.multiple_scattering = report.multiple_scattering;
   out.metadata.entries.push_back(
       {"multiple_scattering",
-       diffuse ? "inside voxels (tables) and between them (the diffuse field at " + std::to_string(settings.table_nodes) +
+       diffuse ? "inside voxels (tables) and between them (the diffuse field at " + std::to_string(p.table_nodes) +
                      " attenuations; spectral renderer)"
-       : tables ? "inside voxels (tables), none between them (spectral renderer)"
-               : "none (spectral renderer: thin-voxel single scattering)"});
+       : p.tables ? "inside voxels (tables), none between them (spectral renderer)"
+                  : "none (spectral renderer: thin-voxel single scattering)"});
   out.metadata.entries.push_back({"spec_nodes", sr.table_nodes});
-  out.metadata.entries.push_back({"spec_emission", int(emission.size())});
+  out.metadata.entries.push_back({"spec_emission", p.emission_components});
   out.metadata.entries.push_back({"spec_method", sr.method});
   out.metadata.entries.push_back({"spec_basis", sr.basis});
   out.metadata.entries.push_back({"spec_atten", sr.attenuation});
@@ -295,6 +356,10 @@ RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& o) {
   out.metadata.entries.push_back({"spec_max_tau", sr.max_depth});
   if (sr.method == "double") out.metadata.entries.push_back({"spec_samples", sr.wavelengths});
   return out;
+}
+
+RenderOutput render_spectral_scene(const Scene& scene, const RenderOptions& options) {
+  return render_prepared_spectral(*prepare_spectral(scene, options), scene.camera);
 }
 
 }  // namespace nebula

@@ -92,5 +92,25 @@ TEST_F(SpectralSceneGpu, RenderAgreesWithTheCpu) {
   EXPECT_LT(d, 1e-3);
 }
 
+// Prepared once on the GPU (the depth bakes with their device copies, the
+// fields), each of three views, the first again last, is the whole render of
+// that view on the GPU.
+TEST_F(SpectralSceneGpu, PreparedOnceEachViewIsTheWholeRender) {
+  NEBULA_SKIP_WITHOUT_GPU();
+  const Scene s = scene();
+  RenderOptions o;
+  o.backend = Backend::Cuda;
+  const std::shared_ptr<const PreparedSpectral> prepared = prepare_spectral(s, o);
+  CameraSettings moved = s.camera;
+  moved.position = {2.5, -2, 1.6};
+  for (const CameraSettings& camera : {s.camera, moved, s.camera}) {
+    Scene whole = s;
+    whole.camera = camera;
+    const double d = worst_of_peak(render_prepared_spectral(*prepared, camera).image, render_scene(whole, o).image);
+    std::printf("  a view of the prepared scene against its whole render, CUDA: %.3g of the peak\n", d);
+    EXPECT_LT(d, 1e-5);
+  }
+}
+
 }  // namespace
 }  // namespace nebula

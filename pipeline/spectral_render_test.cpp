@@ -10,6 +10,7 @@
 #include "illumination/optical_depth_bake.h"
 #include "imageio/image_output.h"
 #include "pipeline/render_scene.h"
+#include "pipeline/render_session.h"
 #include "pipeline/run_setup.h"
 #include "pipeline/spectral_scene.h"
 #include "pipeline/table_source.h"
@@ -367,6 +368,54 @@ TEST_F(SpectralScene, AlbedoAndGVaryingWithWavelength) {
     render_scene(curve_scene("[spectral.dust]\nwavelength_nm = [400, 800]\ng = [0.5, 0.6]\n",
                              {"spectral.method=double"}), options());
   }, {"curve.toml", "spectral.method", "tables = false"});
+}
+
+// Prepared once (model, tables, depth bakes, the light between voxels'
+// fields), each view is what a whole render with that camera gives, bit for
+// bit: the viewer's frames and `nebula render` cannot differ.
+TEST_F(SpectralScene, PreparedOnceEachViewIsTheWholeRender) {
+  const Scene s = scene("method = \"projection\"\nbasis = 4\n", {"render.diffuse_photons=131072"});
+  ASSERT_EQ(s.multiple_scattering, MultipleScattering::Diffuse);
+  const std::shared_ptr<const PreparedSpectral> prepared = prepare_spectral(s, options());
+  ASSERT_TRUE(prepared->diffuse.has_value());
+  CameraSettings moved = s.camera;
+  moved.position = {2.5, -2, 1.6};
+  Image first;
+  for (const CameraSettings& camera : {s.camera, moved}) {
+    Scene whole = s;
+    whole.camera = camera;
+    const RenderOutput expected = render_spectral_scene(whole, options());
+    const RenderOutput view = render_prepared_spectral(*prepared, camera);
+    ASSERT_EQ(view.image.pixels.size(), expected.image.pixels.size());
+    for (size_t i = 0; i < view.image.pixels.size(); ++i)
+      ASSERT_EQ(view.image.pixels[i], expected.image.pixels[i]) << "pixel value " << i;
+    EXPECT_EQ(view.report.multiple_scattering, "diffuse");
+    EXPECT_GT(view.report.diffuse.seconds, 0.0);  // the preparation's bake, reported with each view
+    if (first.pixels.empty()) first = view.image;
+  }
+  double moved_by = 0, total = 0;
+  const Image last = render_prepared_spectral(*prepared, moved).image;
+  for (size_t i = 0; i < first.pixels.size(); ++i) {
+    moved_by += std::fabs(last.pixels[i] - first.pixels[i]);
+    total += first.pixels[i];
+  }
+  EXPECT_GT(moved_by, 0.05 * total);  // the second view is another view
+}
+
+// Sweeps and the Python module render through a RenderSession: a [spectral]
+// scene there is the spectral renderer's image, as `nebula render` gives it,
+// its overrides applied (here the camera).
+TEST_F(SpectralScene, ASessionRendersItWithTheSpectralRenderer) {
+  const Scene s = scene("method = \"projection\"\nbasis = 4\n", {"render.diffuse_photons=65536"});
+  RenderSession session = RenderSession::from_file(path("scene.toml"), {"render.diffuse_photons=65536"}, options());
+  const RenderOutput first = session.render();
+  ASSERT_TRUE(first.report.spectral.has_value());
+  EXPECT_EQ(first.image.pixels, render_scene(s, options()).image.pixels);
+  const RenderOutput moved = session.render({"camera.position=[2.5, -2, 1.6]"});
+  Scene moved_scene = s;
+  moved_scene.camera.position = {2.5, -2, 1.6};
+  EXPECT_EQ(moved.image.pixels, render_scene(moved_scene, options()).image.pixels);
+  EXPECT_NE(moved.image.pixels, first.image.pixels);
 }
 
 TEST_F(SpectralScene, BadSettingsNameTheKeyAndWriteNothing) {

@@ -1,9 +1,17 @@
 #pragma once
 // A [spectral] scene's settings for the spectral library (spectral/): the
 // scene's method, basis and depths, its extinction law and R_V. What
-// render_spectral_scene (render_scene.h) builds its model with.
+// render_spectral_scene (render_scene.h) builds its model with; and the scene
+// prepared once for many views (the viewer's frames).
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "diffuse/diffuse_field.h"
 #include "illumination/optical_depth_bake.h"
 #include "pipeline/render_scene.h"
+#include "pipeline/scene_bands.h"
+#include "raycast/renderer.h"
 #include "scene/scene.h"
 #include "spectral/spectral_model.h"
 #include "spectral/spectral_renderer.h"
@@ -11,6 +19,15 @@
 namespace nebula {
 
 spectral::SpectralSettings spectral_settings(const Scene& scene);
+
+// The light between voxels in two steps: each star's field baked at the
+// model's table nodes (does not depend on the view), then, for a camera, the
+// fields' per-view pass.
+struct SpectralDiffuseFields {
+  std::vector<DiffuseField> fields;             // [star]
+  std::vector<RenderBand> render_bands;         // [node]
+  std::vector<std::vector<double>> node_power;  // [star][node], L_sun um^-1
+};
 
 // The light between voxels for the spectral renderer (docs/spectral.md, "Light
 // between voxels"): per star, the band renderer's diffuse field of that star
@@ -26,5 +43,34 @@ spectral::SpectralDiffuseLight spectral_diffuse_light(const Scene& scene, const 
                                                       BakeResult& bake,
                                                       const Camera& camera, const RenderOptions& o,
                                                       RunReport& report, double* view_seconds);
+
+SpectralDiffuseFields bake_spectral_diffuse(const Scene& scene, const spectral::SpectralModel& model,
+                                            const std::vector<const ScatteringTable*>& tables, BakeResult& bake,
+                                            const RenderOptions& o, RunReport& report);
+spectral::SpectralDiffuseLight spectral_diffuse_view(const Scene& scene, const SpectralDiffuseFields& fields,
+                                                     BakeResult& bake, const Camera& camera, Backend backend,
+                                                     double* view_seconds);
+
+// A [spectral] scene made ready for many views: its model (filters, basis,
+// star and depth tables), the voxels' tables, the stars' depth bakes and the
+// light between voxels' fields. A view (render_prepared_spectral) then costs
+// the fields' per-view pass, the march and the resolve: what `nebula render`
+// does after its preparation, so its image equals render_spectral_scene's
+// with that camera. The scene must outlive it.
+struct PreparedSpectral {
+  const Scene* scene = nullptr;
+  RenderOptions options;
+  SceneBands bands;
+  RunReport report;  // the preparation's (tables, bakes, model); each view adds its own
+  spectral::SpectralModel model;
+  std::shared_ptr<const ScatteringTable> table;                    // the dust's, or null
+  std::vector<std::shared_ptr<const ScatteringTable>> node_tables;  // albedo and g varying with wavelength
+  std::shared_ptr<BakeResult> bake;  // shared, not const: the views' CUDA passes keep its device copies
+  std::optional<SpectralDiffuseFields> diffuse;
+  int table_nodes = 0, emission_components = 0;
+  bool tables = false;
+};
+std::shared_ptr<const PreparedSpectral> prepare_spectral(const Scene& scene, const RenderOptions& options);
+RenderOutput render_prepared_spectral(const PreparedSpectral& prepared, const CameraSettings& camera);
 
 }  // namespace nebula

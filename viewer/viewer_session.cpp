@@ -13,6 +13,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "pipeline/axial_map_source.h"
+#include "pipeline/spectral_scene.h"
 #include "reconstruct/reconstruct.h"
 #include "scene/scene_file.h"
 #include "viewer/demo_scene_text.h"
@@ -136,7 +137,8 @@ struct Session::Baked {
         options(o),
         prepared(per_frame()                              ? PreparedGrid{}
                  : previous && !previous->per_frame() ? prepare_grid(*scene, o, previous->prepared)
-                                                          : prepare_grid(*scene, o)) {
+                                                          : prepare_grid(*scene, o)),
+        spectral(scene->spectral ? prepare_spectral(*scene, o) : nullptr) {
     // The previews' coarser grid (ViewerOptions::preview_coarsening), its bakes reused alike.
     const bool pyramid = scene->pyramid_levels > 0 || scene->multiple_scattering == MultipleScattering::Pyramid;
     if (per_frame() || pyramid || coarsening <= 0) return;
@@ -144,15 +146,19 @@ struct Session::Baked {
     coarse = std::make_unique<const Baked>(std::make_shared<const Scene>(coarsened_scene(*scene, coarsening)), o,
                                            before, 0);
   }
+  // A [spectral] scene's model, tables, depth bakes and fields: each view is
+  // then its per-view pass, march and resolve (pipeline/spectral_scene.h).
+  std::shared_ptr<const PreparedSpectral> spectral;
   std::unique_ptr<const Baked> coarse;  // the previews' grid, or null
 
-  // An axial map bakes with its render (cheap beside a 3D grid's bake); the
-  // spectral renderer has no bake to keep.
+  // No grid of the band renderer: an axial map bakes with its render (cheap
+  // beside a 3D grid's bake), a spectral scene keeps its own (`spectral`).
   bool per_frame() const { return scene->axial.has_value() || scene->spectral.has_value(); }
 
   RenderOutput render(const CameraSettings& camera, bool preview) const {
     if (preview && coarse) return coarse->render(camera, true);
     if (!per_frame()) return render_prepared(prepared, camera, preview);
+    if (spectral) return render_prepared_spectral(*spectral, camera);
     Scene copy = *scene;
     copy.camera = camera;
     return render_scene(copy, options);
@@ -521,7 +527,7 @@ void Session::work() {
         good = source;
         status_.error.clear();
         status_.bake_seconds = seconds;
-        status_.report = baked_->prepared.report;
+        status_.report = baked_->spectral ? baked_->spectral->report : baked_->prepared.report;
         status_.version = version;
         rendered_request_ = 0;  // the current view again, from the new bake
       } else {
@@ -546,6 +552,7 @@ void Session::work() {
         RenderOutput out = current->render(camera, preview);
         frame.image = std::move(out.image);
         frame.metadata = std::move(out.metadata);
+        frame.report = std::move(out.report);
         frame.camera = camera;
         frame.preview = preview;
         frame.request = request;

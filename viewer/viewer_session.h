@@ -68,6 +68,7 @@ struct ViewerOptions {
 struct Frame {
   Image image;             // science pixels (radiance)
   ImageMetadata metadata;  // as render_prepared gives it
+  RunReport report;        // the render's, with the bakes it was rendered from (their times as baked)
   CameraSettings camera;   // the view, at the size rendered
   bool preview = false;    // the quick frame of a moving camera (Session::request)
   double seconds = 0;      // rendering it

@@ -124,6 +124,30 @@ TEST_F(ViewerSession, AnEditKeepsTheBakesItDoesNotChange) {
   EXPECT_FALSE(s.status().report.bake.reused);
 }
 
+// A [spectral] scene is prepared once: a moved camera renders the new view
+// from the same bakes (the times they report do not change) and each frame is
+// `nebula render`'s image of that view.
+TEST_F(ViewerSession, ASpectralSceneIsBakedOnceForEveryView) {
+  const std::string text = std::string(kScene) + "[spectral]\nmethod = \"projection\"\n";
+  Session s(SceneSource(text, "v.toml", "."), options());
+  CameraSettings camera = s.scene().camera;
+  const Frame first = frame_of(s, camera);
+  camera.position = {2.5f, -2.0f, 1.4f};
+  const Frame second = frame_of(s, camera);
+  const RunReport &a = first.report, &b = second.report;
+  ASSERT_TRUE(b.spectral.has_value());
+  EXPECT_GT(b.diffuse.seconds, 0.0);
+  EXPECT_EQ(a.diffuse.seconds, b.diffuse.seconds);  // a field baked again would take a time of its own
+  EXPECT_EQ(a.bake.seconds, b.bake.seconds);
+  EXPECT_EQ(s.status().report.diffuse.seconds, b.diffuse.seconds);
+  Scene moved = load_scene_text(text, "v.toml", ".");
+  moved.camera = camera;
+  RenderOptions o;
+  o.table_photons = 1000;
+  EXPECT_EQ(render_scene(moved, o).image.pixels, second.image.pixels);
+  EXPECT_NE(first.image.pixels, second.image.pixels);
+}
+
 TEST_F(ViewerSession, APreviewIsTheCoarserGridsQuickFrame) {
   ViewerOptions o = options();
   o.preview_coarsening = 1;
