@@ -32,6 +32,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/gpu.h"
+#include "illumination/filters.h"
 #include "imageio/image_output.h"
 #include "viewer/display_image.h"
 #include "viewer/gpu_frame.h"
@@ -610,6 +611,27 @@ int run(const Args& args) {
           view.keys.push_back(k);
         }
         ImGui::Text("%zu keyframe(s) recorded (saved with the scene)", view.keys.size());
+      }
+      if (scene.spectral && ImGui::CollapsingHeader("Filters", ImGuiTreeNodeFlags_DefaultOpen)) {
+        // The spectral renderer integrates through any filter: each plane's
+        // filter, picked from those `nebula filters` lists (the model is built
+        // again for them; docs/spectral.md).
+        static const std::vector<FilterInfo> known = known_filters();
+        for (size_t b = 0; b < scene.bands.size(); ++b) {
+          const std::string label = "plane " + std::to_string(b + 1);
+          if (ImGui::BeginCombo(label.c_str(), scene.bands[b].c_str())) {
+            for (const FilterInfo& f : known) {
+              const bool selected = f.name == scene.bands[b];
+              if (ImGui::Selectable(f.name.c_str(), selected) && !selected) {
+                std::vector<std::string> bands = scene.bands;
+                bands[b] = f.name;
+                edit("bands", toml_strings(bands));
+              }
+              if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", f.source.c_str());
+            }
+            ImGui::EndCombo();
+          }
+        }
       }
       if (ImGui::CollapsingHeader("Dust", ImGuiTreeNodeFlags_DefaultOpen)) {
         for (size_t b = 0; b < scene.bands.size(); ++b) {

@@ -77,6 +77,16 @@ std::string toml_number(double v) {
   return s;
 }
 
+std::string toml_strings(const std::vector<std::string>& values) {
+  std::string out = "[";
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (values[i].find_first_of("\"\\\n") != std::string::npos)
+      throw Error("'" + values[i] + "': a name with a quote, backslash or line break cannot be a scene value");
+    out += (i ? ", \"" : "\"") + values[i] + "\"";
+  }
+  return out + "]";
+}
+
 std::string toml_vec3(Vec3 v) {
   char text[120];
   std::snprintf(text, sizeof text, "[%.9g, %.9g, %.9g]", double(v.x), double(v.y), double(v.z));

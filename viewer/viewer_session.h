@@ -48,6 +48,9 @@ class SceneSource {
 // written to round-trip (9 significant digits), numbers %.17g.
 std::string toml_vec3(Vec3 v);
 std::string toml_number(double v);
+// A list of names as a TOML array of strings, e.g. ["sdss_g", "V"] (Error for a
+// name holding a quote, a backslash or a line break).
+std::string toml_strings(const std::vector<std::string>& values);
 
 // The view as overrides of the scene (camera.*, display.*, and the recorded
 // keyframes as animation.keyframes when there are two or more), so that the

@@ -148,6 +148,27 @@ TEST_F(ViewerSession, ASpectralSceneIsBakedOnceForEveryView) {
   EXPECT_NE(first.image.pixels, second.image.pixels);
 }
 
+// The panel's filter choice is an edit of `bands`: the frame's planes are then
+// the new filters' integrals, as `nebula render` gives them.
+TEST_F(ViewerSession, ASpectralScenesFiltersChangeAtRunTime) {
+  const std::string text = std::string(kScene) + "[spectral]\nmethod = \"projection\"\n";
+  Session s(SceneSource(text, "v.toml", "."), options());
+  const CameraSettings camera = s.scene().camera;
+  const Frame before = frame_of(s, camera);
+  const std::vector<std::string> sdss = {"sdss_g", "sdss_r", "sdss_i"};
+  EXPECT_EQ(toml_strings(sdss), "[\"sdss_g\", \"sdss_r\", \"sdss_i\"]");
+  s.edit("bands", toml_strings(sdss));
+  const Frame after = frame_of(s, camera);
+  EXPECT_TRUE(s.status().error.empty()) << s.status().error;
+  ASSERT_EQ(after.image.bands, sdss);
+  RenderOptions o;
+  o.table_photons = 1000;
+  EXPECT_EQ(render_scene(load_scene_text(text, "v.toml", ".", {"bands=" + toml_strings(sdss)}), o).image.pixels,
+            after.image.pixels);
+  EXPECT_NE(before.image.pixels, after.image.pixels);
+  EXPECT_THROW(toml_strings({"a\"b"}), Error);
+}
+
 TEST_F(ViewerSession, APreviewIsTheCoarserGridsQuickFrame) {
   ViewerOptions o = options();
   o.preview_coarsening = 1;
