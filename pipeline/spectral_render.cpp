@@ -31,10 +31,6 @@ spectral::SpectralMethod method_of(const std::string& name) {
   return spectral::SpectralMethod::Projection;
 }
 
-}  // namespace
-
-namespace {
-
 // One band per table node: its attenuation kappa_m, the dust's albedo, g and
 // table (the node's own when albedo and g vary with wavelength), and the
 // wavelength where kappa(lambda_m) = kappa_m.
