@@ -84,6 +84,9 @@ TEST(ReuseGrids, TakesTheDensityOverOnlyWhenItsTablesAreUnchanged) {
   EXPECT_EQ(edited.density.tau_v[0], 123.0f);
   EXPECT_EQ(edited.dust.albedo[0], 0.9);
   EXPECT_EQ(edited.stars[0].luminosity_lsun, 5e3);
+  // Other bands: the density does not follow them (emission grids would: an [emission] table names them).
+  const Scene filtered = load_scene_text(text, "s.toml", ".", {"bands=[\"U\", \"sdss_g\"]"}, &previous);
+  EXPECT_EQ(filtered.density.tau_v[0], 123.0f);
   const Scene reseeded = load_scene_text(text, "s.toml", ".", {"density.procedural.seed=2"}, &previous);
   EXPECT_NE(reseeded.density.tau_v[0], 123.0f);
   const Scene scaled = load_scene_text(text, "s.toml", ".", {"density.scale=2"}, &previous);

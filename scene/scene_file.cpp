@@ -1044,13 +1044,17 @@ Scene Parser::build(toml::table& root, const Scene* reuse_grids) {
     if (!scene.dust.table_files[b].empty())
       scene.inputs.push_back({"dust.tables." + scene.bands[b], scene.dust.table_files[b]});
   // What the grids are made of: the [density] and [emission] tables as
-  // printed, the bands (emission grids follow them) and the scene's folder.
+  // printed, with an [emission] table the bands (its grids follow them), and
+  // the scene's folder.
   if (!axial) {
     std::ostringstream source;
-    source << "base=" << base_.string() << "\nbands=";
-    for (const std::string& b : scene.bands) source << b << ",";
+    source << "base=" << base_.string();
     if (const toml::table* d = root["density"].as_table()) source << "\n[density]\n" << toml::toml_formatter(*d);
-    if (const toml::table* e = root["emission"].as_table()) source << "\n[emission]\n" << toml::toml_formatter(*e);
+    if (const toml::table* e = root["emission"].as_table()) {
+      source << "\nbands=";
+      for (const std::string& b : scene.bands) source << b << ",";
+      source << "\n[emission]\n" << toml::toml_formatter(*e);
+    }
     scene.grid_source = source.str();
   }
   if (!axial && reuse_grids && !reuse_grids->grid_source.empty() && reuse_grids->grid_source == scene.grid_source) {
@@ -1188,14 +1192,37 @@ Scene demo_scene() {
   return scene;
 }
 
-std::string scene_text_with_axial_file(const std::string& text, const std::string& file,
-                                       const std::string& emission_prefix) {
-  toml::table root;
+namespace {
+
+toml::table parsed_scene_text(const std::string& text) {
   try {
-    root = toml::parse(std::string_view(text), std::string_view("scene"));
+    return toml::parse(std::string_view(text), std::string_view("scene"));
   } catch (const toml::parse_error& e) {
     throw Error(one_line(std::string("scene text: TOML syntax: ") + std::string(e.description())));
   }
+}
+
+}  // namespace
+
+std::string scene_text_without(const std::string& text, const std::vector<std::string>& keys) {
+  toml::table root = parsed_scene_text(text);
+  for (const std::string& key : keys) {
+    toml::table* table = &root;
+    std::string rest = key;
+    for (size_t dot = rest.find('.'); table != nullptr && dot != std::string::npos; dot = rest.find('.')) {
+      table = (*table)[rest.substr(0, dot)].as_table();
+      rest = rest.substr(dot + 1);
+    }
+    if (table != nullptr) table->erase(rest);
+  }
+  std::ostringstream out;
+  out << toml::toml_formatter(root);
+  return out.str();
+}
+
+std::string scene_text_with_axial_file(const std::string& text, const std::string& file,
+                                       const std::string& emission_prefix) {
+  toml::table root = parsed_scene_text(text);
   toml::table* axial = root["axial"].as_table();
   if (axial == nullptr) throw Error("scene text: no [axial] table to point at " + file);
   for (const char* key : {"synthetic", "nx", "nr", "file", "image", "dataset", "emission_prefix", "tau_channel",

@@ -40,6 +40,12 @@ Scene load_scene_text(const std::string& text, const std::string& name,
 std::string scene_text_with_axial_file(const std::string& text, const std::string& file,
                                        const std::string& emission_prefix);
 
+// A scene's TOML text without some keys, each a dotted path ("bands",
+// "spectral.range_um"; one not there is passed over), printed as toml++
+// prints it: two scenes that differ only in those keys give equal texts.
+// Error when the text is not TOML.
+std::string scene_text_without(const std::string& text, const std::vector<std::string>& keys);
+
 // The built-in demo (`nebula render --demo`), equal to scenes/demo.toml: a
 // procedural nebula tuned to show structure (128^3 voxels, 2 pc; the star
 // off-centre, filaments, docs/scene.md), one O5V star of 2e5 L_sun at the

@@ -355,6 +355,22 @@ look_at = [0.0, 0.0, 1.0]
                         {"no [axial] table", "m.h5"});
 }
 
+// Two scenes that differ only in the keys left out give equal texts; any
+// other difference stays (what a spectral preparation with other filters reuses).
+TEST_F(SceneFile, TextWithoutSomeKeysComparesTheRest) {
+  const std::string a = "bands = [\"B\", \"V\"]\n[spectral]\nmethod = \"projection\"\nrange_um = [0.3, 1.0]\n"
+                        "[camera]\nfov_deg = 30\n";
+  const std::string b = "bands = [\"sdss_g\"]\n[spectral]\nmethod = \"projection\"\n[camera]\nfov_deg = 50\n";
+  const std::vector<std::string> keys = {"bands", "camera", "spectral.range_um", "output.file", "no.such.key"};
+  EXPECT_EQ(scene_text_without(a, keys), scene_text_without(b, keys));
+  EXPECT_NE(scene_text_without(a, {"bands", "camera"}), scene_text_without(b, {"bands", "camera"}));
+  const std::string c = "bands = [\"B\"]\n[spectral]\nmethod = \"double\"\n";
+  EXPECT_NE(scene_text_without(a, keys), scene_text_without(c, keys));
+  EXPECT_EQ(scene_text_without(a, keys).find("range_um"), std::string::npos);
+  EXPECT_NE(scene_text_without(a, keys).find("method"), std::string::npos);
+  testing::expect_error([&] { scene_text_without("bands = [", keys); }, {"scene text", "TOML syntax"});
+}
+
 TEST_F(SceneFile, RefusesAMissingSceneFile) {
   expect_error([&] { load_scene(path("nothing.toml")); }, {"nothing.toml", "cannot read", "No such file"});
   expect_error([&] { load_scene(dir_.string()); }, {"directory"});
