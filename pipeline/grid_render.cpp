@@ -27,15 +27,6 @@ std::string mode_of(const RenderOptions& o) {
 // Exact text of a float, so equal keys mean equal inputs.
 std::string exact(double v) { return to_text(v); }
 
-// What the star bakes depend on: the grid (by what it was made from; a scene
-// built in code has no such text and never reuses) and the stars' positions.
-std::string bake_key(const Scene& scene, const SceneBands& bands, Backend backend) {
-  if (scene.grid_source.empty()) return "";
-  std::string key = scene.grid_source + "|backend " + std::to_string(int(backend)) + "|stars";
-  for (const StarLight& s : bands.stars) key += " " + exact(s.position.x) + "," + exact(s.position.y) + "," + exact(s.position.z);
-  return key;
-}
-
 // What the diffuse field's photons depend on besides the bakes: each band's
 // extinction and g, the stars' powers and the field's settings.
 std::string photon_key(const std::string& bake, const Scene& scene, const SceneBands& bands) {
@@ -77,7 +68,7 @@ bool bakes_field(const Scene& scene, const SceneBands& bands) {
 
 DiffuseKeys diffuse_keys(const Scene& scene, const SceneBands& bands, const RenderOptions& o) {
   if (!bakes_field(scene, bands)) return {};
-  const std::string bake = bake_key(scene, bands, o.backend);
+  const std::string bake = star_bake_key(scene, o.backend);
   return {photon_key(bake, scene, bands), diffuse_key(bake, scene, bands, o)};
 }
 
@@ -124,7 +115,7 @@ PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o, PreparedGr
   // Stars: one V-band depth bake each, when something scatters their light.
   std::vector<Vec3> positions;
   for (const StarLight& s : p.bands.stars) positions.push_back(s.position);
-  p.bake_key = bake_key(scene, p.bands, o.backend);
+  p.bake_key = star_bake_key(scene, o.backend);
   const bool reuse_bake = !p.bake_key.empty() && p.bake_key == previous.bake_key && !previous.bake.tau_v.empty();
   if (any && !positions.empty() && reuse_bake) {
     p.bake = std::move(previous.bake);
@@ -201,7 +192,7 @@ PreparedGrid prepare_grid(const Scene& scene, const RenderOptions& o, const Prep
   // again), leaving `previous` whole: another thread may still render from it.
   PreparedGrid donor;
   const SceneBands bands = scene_bands(scene);
-  const std::string bake = bake_key(scene, bands, o.backend);
+  const std::string bake = star_bake_key(scene, o.backend);
   if (bake.empty() || bake != previous.bake_key || previous.bake.tau_v.empty())
     return prepare_grid(scene, o, std::move(donor));
   donor.bake_key = previous.bake_key;

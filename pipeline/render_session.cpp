@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "pipeline/run_setup.h"
+#include "pipeline/spectral_scene.h"
 #include "scene/scene_file.h"
 
 namespace nebula {
@@ -48,7 +49,7 @@ const Scene& RenderSession::load(const std::vector<std::string>& overrides) {
   const std::vector<SceneInput> inputs = scene_->inputs;
   // The preparation points into the old scene: keep the old one alive until
   // the next render has taken what it can from that preparation.
-  if (prepared_) retired_ = std::move(scene_);
+  if (prepared_ || spectral_) retired_ = std::move(scene_);
   scene_ = std::move(next);
   if (scene_->inputs.empty() || scene_->inputs.front().key != "scene") {
     // load_scene_text does not know the file: carry the file's own entry over.
@@ -148,11 +149,18 @@ RenderOutput RenderSession::render(const std::vector<std::string>& overrides) {
   const auto start = std::chrono::steady_clock::now();
   const Scene& scene = load(overrides);
   RenderOutput out;
-  if (scene.axial || scene.spectral) {  // their own renderers, whole each time (render_scene)
+  if (scene.spectral) {  // the spectral renderer, keeping what the overrides left unchanged
     prepared_.reset();
+    spectral_ = prepare_spectral(scene, options_, spectral_.get());
+    retired_.reset();
+    out = render_prepared_spectral(*spectral_, scene.camera);
+  } else if (scene.axial) {  // its own renderer, whole each time (render_scene)
+    prepared_.reset();
+    spectral_.reset();
     retired_.reset();
     out = render_scene(scene, options_);
   } else {
+    spectral_.reset();
     PreparedGrid previous = prepared_ ? std::move(*prepared_) : PreparedGrid{};
     const bool handed = hand_shared_field(scene, previous);
     auto next = std::make_unique<PreparedGrid>(prepare_grid(scene, options_, std::move(previous)));

@@ -6,7 +6,8 @@
 // only when [density], [emission] or the bands change, the star bakes only
 // when the grid or the stars' positions do, the diffuse field when the dust,
 // the tables or the stars' light do (prepare_grid's re-preparing overload).
-// A camera edit costs the frame alone.
+// A camera edit costs the frame alone. A [spectral] scene keeps its depth
+// bakes, model and fields alike (prepare_spectral's `previous`).
 #include <map>
 #include <memory>
 #include <string>
@@ -16,6 +17,8 @@
 #include "pipeline/shared_diffuse.h"
 
 namespace nebula {
+
+struct PreparedSpectral;  // pipeline/spectral_scene.h
 
 class RenderSession {
  public:
@@ -60,6 +63,7 @@ class RenderSession {
   // The last scene (on the heap: the preparation points into it) and its preparation.
   std::unique_ptr<Scene> scene_, retired_;
   std::unique_ptr<PreparedGrid> prepared_;
+  std::shared_ptr<const PreparedSpectral> spectral_;  // a [spectral] scene's preparation, instead
   // The plan: per group, its fields not yet baked (bands and tables, taken
   // while planning); fields baked ahead, by key.
   struct PlanGroup {

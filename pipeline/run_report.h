@@ -119,6 +119,9 @@ struct SpectralReport {
   double model_seconds = 0;       // fits, basis and tables (host)
   double resolve_seconds = 0;     // accumulators to one plane per filter
   double diffuse_view_seconds = 0;  // light between voxels: the field's per-view pass and the voxels' terms
+  // The model's basis and tables taken over from an earlier preparation
+  // (prepare_spectral's `previous`), new filters put on them when they changed.
+  bool basis_kept = false;
 };
 
 struct RunReport {

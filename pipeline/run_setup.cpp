@@ -12,6 +12,14 @@
 
 namespace nebula::pipeline_detail {
 
+std::string star_bake_key(const Scene& scene, Backend backend) {
+  if (scene.grid_source.empty()) return "";
+  std::string key = scene.grid_source + "|backend " + std::to_string(int(backend)) + "|stars";
+  for (const SceneStar& s : scene.stars)
+    key += " " + to_text(s.position.x) + "," + to_text(s.position.y) + "," + to_text(s.position.z);
+  return key;
+}
+
 RunReport begin_report(const Scene& scene, const SceneBands& bands, const std::string& renderer, Backend backend,
                        const std::vector<bool>& scatters) {
   RunReport r;

@@ -30,6 +30,11 @@ inline double seconds_since(std::chrono::steady_clock::time_point t) {
 RunReport begin_report(const Scene& scene, const SceneBands& bands, const std::string& renderer, Backend backend,
                        const std::vector<bool>& scatters = {});
 
+// What the star bakes depend on: the grid (by what it was made from; a scene
+// built in code has no such text and gets "", which never reuses), the
+// stars' positions and the backend. Equal keys, equal bakes.
+std::string star_bake_key(const Scene& scene, Backend backend);
+
 // The unit of every rendered image: radiance per band, in a form FITS and
 // astropy.units parse (docs/image_files.md).
 inline const char* const kRadianceUnit = "solLum pc-2 sr-1";

@@ -10,16 +10,17 @@ namespace nebula {
 
 bool is_grey_band(const std::string& name) { return name == kGreyBand; }
 
+Passband band_filter(const Scene& scene, const std::string& name) {
+  const auto own = std::find_if(scene.filters.begin(), scene.filters.end(),
+                                [&](const SceneFilter& f) { return f.name == name; });
+  return own != scene.filters.end() ? own->passband
+         : is_grey_band(name)       ? Passband{kGreyBand, {}, {}}
+                                    : load_filter(name);
+}
+
 SceneBands scene_bands(const Scene& scene) {
   SceneBands out;
-  // The grey band has no filter: an empty passband named "grey" holds its place.
-  for (const std::string& name : scene.bands) {
-    const auto own = std::find_if(scene.filters.begin(), scene.filters.end(),
-                                  [&](const SceneFilter& f) { return f.name == name; });
-    out.filters.push_back(own != scene.filters.end() ? own->passband
-                          : is_grey_band(name)       ? Passband{kGreyBand, {}, {}}
-                                                     : load_filter(name));
-  }
+  for (const std::string& name : scene.bands) out.filters.push_back(band_filter(scene, name));
   const Passband V = load_filter("V");
   for (size_t b = 0; b < scene.bands.size(); ++b) {
     const double ratio = is_grey_band(scene.bands[b])

@@ -1,6 +1,7 @@
 #pragma once
 // The band physics of a scene (DESIGN.md section 3, "Bands"): every renderer
 // sees a scene's bands and stars through this, computed in one place.
+#include <string>
 #include <vector>
 
 #include "core/bands.h"
@@ -28,5 +29,10 @@ struct SceneBands {
 };
 
 SceneBands scene_bands(const Scene& scene);
+
+// The filter a band name stands for in a scene: the scene's own [filters]
+// entry, else the registry's (load_filter; Error for an unknown name). The
+// grey band has no filter: an empty passband named "grey" holds its place.
+Passband band_filter(const Scene& scene, const std::string& name);
 
 }  // namespace nebula

@@ -2,6 +2,7 @@
 // filters fitted, the stars' black bodies, the scene's extinction law as a
 // function of wavelength; one V-band depth bake per star; the spectral march
 // (spectral/) and the resolve into one plane per filter.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -13,6 +14,7 @@
 #include "pipeline/run_setup.h"
 #include "pipeline/spectral_scene.h"
 #include "pipeline/table_source.h"
+#include "scene/scene_file.h"
 #include "raycast/renderer.h"
 #include "spectral/spectral_renderer.h"
 
@@ -170,15 +172,137 @@ spectral::SpectralSettings spectral_settings(const Scene& scene) {
   return s;
 }
 
-std::shared_ptr<const PreparedSpectral> prepare_spectral(const Scene& scene, const RenderOptions& o) {
+namespace {
+
+// The filters as the spectral library takes them: each band's name and curve.
+std::vector<std::pair<std::string, Passband>> band_filters(const Scene& scene, const SceneBands& bands) {
+  std::vector<std::pair<std::string, Passband>> filters;
+  for (size_t b = 0; b < scene.bands.size(); ++b) filters.push_back({scene.bands[b], bands.filters[b]});
+  return filters;
+}
+
+// The report's account of a model: its method, basis, range, nodes and filters.
+SpectralReport spectral_report(const Scene& scene, const spectral::SpectralModel& model,
+                               const spectral::SpectralSettings& settings,
+                               const std::vector<std::pair<std::string, Passband>>& filters) {
+  const bool varying = !scene.spectral->dust_nm.empty();
+  SpectralReport sr;
+  sr.method = scene.spectral->method;
+  sr.basis = model.basis.size();
+  sr.wavelengths = settings.wavelengths;
+  sr.breaks = int(model.breaks.size());
+  sr.attenuation = scene.spectral->attenuation;
+  sr.norm = scene.spectral->norm;
+  sr.lo_um = model.lo_um;
+  sr.hi_um = model.hi_um;
+  sr.fit_depth = model.fit_depth;
+  sr.max_depth = model.max_depth;
+  sr.elements = model.element_depth;
+  sr.basis_error = model.basis.error.empty() ? 0.0 : model.basis.error.back();
+  sr.accumulators = model.planes();
+  for (const spectral::SpectralEmission& e : model.emission) ++(e.line_um > 0 ? sr.emission_lines : sr.emission_continua);
+  sr.table_nodes = scene.spectral->tables || varying ? settings.table_nodes : 0;
+  sr.node_kappa = scene.spectral->tables || varying ? model.node_kappa : std::vector<double>{};
+  sr.node_albedo = model.node_albedo;
+  sr.node_g = model.node_g;
+  for (size_t b = 0; b < filters.size(); ++b)
+    sr.filters.push_back({filters[b].first, filters[b].second.wavelength_nm.front(),
+                          filters[b].second.wavelength_nm.back(), pivot_wavelength_nm(filters[b].second),
+                          model.fits[b].segments, model.fits[b].max_error});
+  return sr;
+}
+
+// PreparedSpectral::depends_on: everything but the filters and the view. The
+// dust's per-band keys go too: the albedo, g and table the spectral renderer
+// reads (the first band's) are compared as values (keeps_bakes).
+std::string spectral_depends_on(const Scene& scene, const RenderOptions& o) {
+  if (scene.resolved_toml.empty()) return "";
+  return scene_text_without(scene.resolved_toml, {"bands", "filters", "camera", "display", "output", "animation",
+                                                  "spectral.range_um", "dust.albedo", "dust.g", "dust.tables"}) +
+         "\n# grids: " + scene.grid_source + "\n# backend " + to_string(o.backend) + ", table photons " +
+         std::to_string(o.table_photons) + "\n";
+}
+
+// The wavelength range a fresh model of these filters takes (build_spectral_model).
+std::pair<double, double> basis_range(const spectral::SpectralSettings& settings,
+                                      const std::vector<std::pair<std::string, Passband>>& filters) {
+  if (settings.lo_um > 0 || settings.hi_um > 0) return {settings.lo_um, settings.hi_um};
+  double lo = 1e30, hi = 0;
+  for (const auto& [name, band] : filters) {
+    lo = std::min(lo, band.wavelength_nm.front() / 1000.0);
+    hi = std::max(hi, band.wavelength_nm.back() / 1000.0);
+  }
+  return {lo, hi};
+}
+
+bool same_table(const ScatteringTable* a, const ScatteringTable* b) {
+  if (a == b) return true;
+  if (a == nullptr || b == nullptr) return false;
+  return a->albedo == b->albedo && a->g == b->g && a->mu_binning == b->mu_binning && a->tau == b->tau &&
+         a->mu_edges == b->mu_edges && a->P == b->P;
+}
+
+// What the model depends on besides its filters and range: the [spectral]
+// table, the dust's law, R_V (and its albedo and g, a curve's constants) and
+// the stars: the resolved text less the grids, the render settings and the rest.
+std::string spectral_model_key(const Scene& scene) {
+  if (scene.resolved_toml.empty()) return "";
+  return scene_text_without(scene.resolved_toml,
+                            {"bands", "filters", "camera", "display", "output", "animation", "density", "emission",
+                             "render", "axial", "spectral.range_um", "dust.albedo", "dust.g", "dust.tables"}) +
+         "\n# albedo " + to_text(scene.dust.albedo.front()) + ", g " + to_text(scene.dust.g.front()) + "\n";
+}
+
+bool same_filters(const spectral::SpectralModel& m, const std::vector<std::pair<std::string, Passband>>& filters) {
+  if (m.filter_names.size() != filters.size()) return false;
+  for (size_t f = 0; f < filters.size(); ++f)
+    if (m.filter_names[f] != filters[f].first || m.measured[f].wavelength_nm != filters[f].second.wavelength_nm ||
+        m.measured[f].response != filters[f].second.response)
+      return false;
+  return true;
+}
+
+// Whether previous' model serves this scene: the same settings, stars and
+// range, and the same filters or a method that takes others on its basis.
+bool keeps_model(const PreparedSpectral& previous, const std::string& model_key,
+                 const spectral::SpectralSettings& settings,
+                 const std::vector<std::pair<std::string, Passband>>& filters) {
+  using spectral::SpectralMethod;
+  if (model_key.empty() || model_key != previous.model_key) return false;
+  if (basis_range(settings, filters) != std::make_pair(previous.model.lo_um, previous.model.hi_um)) return false;
+  const SpectralMethod m = settings.method;
+  return same_filters(previous.model, filters) || m == SpectralMethod::Projection || m == SpectralMethod::LightBasis ||
+         m == SpectralMethod::VoxelLight || m == SpectralMethod::Preintegrated;
+}
+
+// Whether previous' fields serve this scene (its depth bakes kept): the same
+// scene but for its filters and view, the same table, albedo and g, the same nodes.
+bool keeps_fields(const PreparedSpectral& previous, const Scene& scene, const std::string& depends_on,
+                  const ScatteringTable* table, const spectral::SpectralModel& model) {
+  if (previous.diffuse == nullptr || depends_on.empty() || depends_on != previous.depends_on) return false;
+  const Scene& before = *previous.scene;  // the spectral renderer reads the first band's albedo and g
+  if (before.dust.albedo.front() != scene.dust.albedo.front() || before.dust.g.front() != scene.dust.g.front())
+    return false;
+  return same_table(previous.table.get(), table) && model.node_kappa == previous.model.node_kappa &&
+         model.node_albedo == previous.model.node_albedo && model.node_g == previous.model.node_g;
+}
+
+}  // namespace
+
+std::shared_ptr<const PreparedSpectral> prepare_spectral(const Scene& scene, const RenderOptions& o,
+                                                         const PreparedSpectral* previous) {
   if (!scene.spectral) throw Error(scene.path + ": spectral: the scene has no [spectral] table");
   validate_scene(scene);
   check_run_memory(scene, RunKind::Fast);
+  if (scene.multiple_scattering == MultipleScattering::Pyramid)
+    throw Error(scene.path + ": render.multiple_scattering: the spectral renderer takes the light between voxels "
+                             "from the diffuse field (\"diffuse\", the default) or none (\"none\"); no pyramid");
   auto prepared = std::make_shared<PreparedSpectral>();
   PreparedSpectral& p = *prepared;
   p.scene = &scene;
   p.options = o;
   p.bands = scene_bands(scene);
+  p.depends_on = spectral_depends_on(scene, o);
   const SceneBands& bands = p.bands;
   RunReport& report = p.report;
   report = begin_report(scene, bands, "spectral", o.backend);
@@ -201,52 +325,55 @@ std::shared_ptr<const PreparedSpectral> prepare_spectral(const Scene& scene, con
 
   // The model: filters as piecewise cubics, basis and tables (host).
   const auto t_model = std::chrono::steady_clock::now();
-  std::vector<std::pair<std::string, Passband>> filters;
-  for (size_t b = 0; b < scene.bands.size(); ++b) filters.push_back({scene.bands[b], bands.filters[b]});
-  std::vector<spectral::SpectralStar> stars;
-  for (const SceneStar& s : scene.stars) stars.push_back({s.temperature_K});
+  const std::vector<std::pair<std::string, Passband>> filters = band_filters(scene, bands);
   const spectral::SpectralSettings settings = spectral_settings(scene);
-  if (scene.multiple_scattering == MultipleScattering::Pyramid)
-    throw Error(scene.path + ": render.multiple_scattering: the spectral renderer takes the light between voxels "
-                             "from the diffuse field (\"diffuse\", the default) or none (\"none\"); no pyramid");
   const bool tables = scene.spectral->tables;
-  std::vector<spectral::SpectralEmission> emission;
-  for (const SpectralEmissionSpec& e : scene.spectral->emission)
-    emission.push_back({e.line_nm / 1000.0, e.continuum, e.lo_nm / 1000.0, e.hi_nm / 1000.0});
-  spectral::SpectralModel model;
-  try {
-    model = spectral::build_spectral_model(filters, stars, settings, emission);
-  } catch (const Error& e) {
-    throw Error(scene.path + ": " + e.what());  // "spectral: <reason>"
-  }
+  p.table_nodes = settings.table_nodes;
+  p.tables = tables;
+  p.emission_components = int(scene.spectral->emission.size());
+
+  p.model_key = spectral_model_key(scene);
+  p.bake_key = star_bake_key(scene, o.backend);
   SpectralReport sr;
-  sr.method = scene.spectral->method;
-  sr.basis = model.basis.size();
-  sr.wavelengths = settings.wavelengths;
-  sr.breaks = int(model.breaks.size());
-  sr.attenuation = scene.spectral->attenuation;
-  sr.norm = scene.spectral->norm;
-  sr.lo_um = model.lo_um;
-  sr.hi_um = model.hi_um;
-  sr.fit_depth = model.fit_depth;
-  sr.max_depth = model.max_depth;
-  sr.elements = model.element_depth;
-  sr.basis_error = model.basis.error.empty() ? 0.0 : model.basis.error.back();
-  sr.accumulators = model.planes();
-  for (const spectral::SpectralEmission& e : model.emission) ++(e.line_um > 0 ? sr.emission_lines : sr.emission_continua);
+  if (previous != nullptr && keeps_model(*previous, p.model_key, settings, filters)) {
+    // The same basis and tables: only the filters' part is made, when they changed.
+    p.model = previous->model;
+    p.model.settings.lo_um = settings.lo_um;
+    p.model.settings.hi_um = settings.hi_um;
+    if (!same_filters(p.model, filters)) try {
+        spectral::set_filters(p.model, filters);
+      } catch (const Error& e) {
+        throw Error(scene.path + ": " + e.what());
+      }
+    sr = spectral_report(scene, p.model, settings, filters);
+    sr.basis_kept = true;
+  } else {
+    std::vector<spectral::SpectralStar> stars;
+    for (const SceneStar& s : scene.stars) stars.push_back({s.temperature_K});
+    std::vector<spectral::SpectralEmission> emission;
+    for (const SpectralEmissionSpec& e : scene.spectral->emission)
+      emission.push_back({e.line_nm / 1000.0, e.continuum, e.lo_nm / 1000.0, e.hi_nm / 1000.0});
+    try {
+      p.model = spectral::build_spectral_model(filters, stars, settings, emission);
+    } catch (const Error& e) {
+      throw Error(scene.path + ": " + e.what());  // "spectral: <reason>"
+    }
+    sr = spectral_report(scene, p.model, settings, filters);
+  }
+  const spectral::SpectralModel& model = p.model;
   // With albedo and g varying: a table per node for its (a, g), from the cache or generated.
   std::vector<std::shared_ptr<const ScatteringTable>> node_tables;
   if (varying && tables)
     for (size_t m = 0; m < model.node_kappa.size(); ++m) {
-      TabulateParams p;
-      p.albedo = model.node_albedo[m];
-      p.g = model.node_g[m];
-      p.binning = AngularBinning::UniformTheta;
-      p.photons_per_row = o.table_photons;
+      TabulateParams tp;
+      tp.albedo = model.node_albedo[m];
+      tp.g = model.node_g[m];
+      tp.binning = AngularBinning::UniformTheta;
+      tp.photons_per_row = o.table_photons;
       const auto t0 = std::chrono::steady_clock::now();
-      TableReport r{p.albedo, p.g, {"node " + std::to_string(m)}, TableOrigin::Cache, "", 0, ""};
-      node_tables.push_back(
-          std::make_shared<const ScatteringTable>(cached_table(p, o.backend, o.progress, &r.origin, &r.path, &r.warning)));
+      TableReport r{tp.albedo, tp.g, {"node " + std::to_string(m)}, TableOrigin::Cache, "", 0, ""};
+      node_tables.push_back(std::make_shared<const ScatteringTable>(
+          cached_table(tp, o.backend, o.progress, &r.origin, &r.path, &r.warning)));
       r.seconds = seconds_since(t0);
       r.noise = node_tables.back()->median_relative_error();
       r.photons_per_row = node_tables.back()->photons_per_row;
@@ -258,33 +385,37 @@ std::shared_ptr<const PreparedSpectral> prepare_spectral(const Scene& scene, con
   // Light between voxels: the band renderer's diffuse field baked at the nodes (needs the tables and a star).
   const bool diffuse = scene.multiple_scattering == MultipleScattering::Diffuse && settings.table_nodes >= 1 &&
                        !scene.stars.empty() && (varying ? !node_tables.empty() : table != nullptr);
-  sr.table_nodes = tables || varying ? settings.table_nodes : 0;
-  sr.node_kappa = tables || varying ? model.node_kappa : std::vector<double>{};
-  sr.node_albedo = model.node_albedo;
-  sr.node_g = model.node_g;
-  for (size_t b = 0; b < filters.size(); ++b)
-    sr.filters.push_back({filters[b].first, filters[b].second.wavelength_nm.front(),
-                          filters[b].second.wavelength_nm.back(), pivot_wavelength_nm(filters[b].second),
-                          model.fits[b].segments, model.fits[b].max_error});
   sr.model_seconds = seconds_since(t_model);
-
-  // One V-band depth bake per star (the spectral march scales it by kappa(lambda)).
-  std::vector<Vec3> positions;
-  for (const SceneStar& s : scene.stars) positions.push_back(s.position);
-  p.bake = std::make_shared<BakeResult>();
-  if (!positions.empty()) {
-    const auto t0 = std::chrono::steady_clock::now();
-    *p.bake = bake_star_depths(scene.density, positions, o.backend);
-    report.bake = {true, positions.size(), scene.density.shape.count(), seconds_since(t0)};
-  }
-  if (diffuse) p.diffuse = bake_spectral_diffuse(scene, model, read_tables, *p.bake, o, report);
   p.table = table;
   p.node_tables = node_tables;
-  p.table_nodes = settings.table_nodes;
-  p.tables = tables;
-  p.emission_components = int(emission.size());
+
+  // One V-band depth bake per star (the spectral march scales it by kappa(lambda)).
+  // Kept from previous when the grid and the stars' positions are the same; the
+  // fields too when nothing they depend on changed either.
+  const bool bake_kept = previous != nullptr && !p.bake_key.empty() && p.bake_key == previous->bake_key;
+  if (bake_kept) {
+    p.bake = previous->bake;
+    report.bake = previous->report.bake;
+    report.bake.reused = true;
+  } else {
+    std::vector<Vec3> positions;
+    for (const SceneStar& s : scene.stars) positions.push_back(s.position);
+    p.bake = std::make_shared<BakeResult>();
+    if (!positions.empty()) {
+      const auto t0 = std::chrono::steady_clock::now();
+      *p.bake = bake_star_depths(scene.density, positions, o.backend);
+      report.bake = {true, positions.size(), scene.density.shape.count(), seconds_since(t0)};
+    }
+  }
+  if (diffuse && bake_kept && keeps_fields(*previous, scene, p.depends_on, table.get(), model)) {
+    p.diffuse = previous->diffuse;
+    report.diffuse = previous->report.diffuse;
+    report.diffuse.reused = true;
+  } else if (diffuse) {
+    p.diffuse = std::make_shared<const SpectralDiffuseFields>(
+        bake_spectral_diffuse(scene, model, read_tables, *p.bake, o, report));
+  }
   report.spectral = sr;
-  p.model = std::move(model);
   return prepared;
 }
 
@@ -310,7 +441,7 @@ RenderOutput render_prepared_spectral(const PreparedSpectral& p, const CameraSet
   in.camera = make_camera(camera);
   in.star_pixels = scene.star_pixels;
   spectral::SpectralDiffuseLight diffuse_light;
-  const bool diffuse = p.diffuse.has_value();
+  const bool diffuse = p.diffuse != nullptr;
   if (diffuse) {
     diffuse_light = spectral_diffuse_view(scene, *p.diffuse, *p.bake, in.camera, p.options.backend, &sr.diffuse_view_seconds);
     in.diffuse = &diffuse_light;

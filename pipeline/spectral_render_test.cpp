@@ -377,7 +377,7 @@ TEST_F(SpectralScene, PreparedOnceEachViewIsTheWholeRender) {
   const Scene s = scene("method = \"projection\"\nbasis = 4\n", {"render.diffuse_photons=131072"});
   ASSERT_EQ(s.multiple_scattering, MultipleScattering::Diffuse);
   const std::shared_ptr<const PreparedSpectral> prepared = prepare_spectral(s, options());
-  ASSERT_TRUE(prepared->diffuse.has_value());
+  ASSERT_NE(prepared->diffuse, nullptr);
   CameraSettings moved = s.camera;
   moved.position = {2.5, -2, 1.6};
   Image first;
@@ -402,6 +402,76 @@ TEST_F(SpectralScene, PreparedOnceEachViewIsTheWholeRender) {
   EXPECT_GT(moved_by, 0.05 * total);  // the second view is another view
 }
 
+// A preparation after an edit keeps what the edit left unchanged (the
+// viewer's Filters panel, sessions, sweeps): new filters within the basis'
+// range keep the tables, depth bakes, fields and basis, for every method
+// that takes new filters on its basis; a star's power keeps its depth bake
+// alone; a star moved keeps nothing. The image is a fresh preparation's, bit
+// for bit, each time.
+TEST_F(SpectralScene, APreparationKeepsWhatTheEditLeftUnchanged) {
+  const std::vector<std::string> pinned = {"render.diffuse_photons=65536", "spectral.range_um=[0.3, 1.0]"};
+  const auto expect_fresh_image = [&](const PreparedSpectral& p, const Scene& s) {
+    const RenderOutput view = render_prepared_spectral(p, s.camera);
+    const RenderOutput fresh = render_spectral_scene(s, options());
+    EXPECT_EQ(view.image.bands, s.bands);
+    ASSERT_EQ(view.image.pixels.size(), fresh.image.pixels.size());
+    for (size_t i = 0; i < view.image.pixels.size(); ++i)
+      ASSERT_EQ(view.image.pixels[i], fresh.image.pixels[i]) << "pixel value " << i;
+  };
+  const auto kept = [](const PreparedSpectral& p) {
+    return std::vector<bool>{p.report.spectral->basis_kept, p.report.bake.reused, p.report.diffuse.reused};
+  };
+  const std::vector<bool> all = {true, true, true};
+  for (const char* method : {"projection", "voxel_light", "preintegrated"}) {
+    SCOPED_TRACE(method);
+    const std::string spectral = "method = \"" + std::string(method) + "\"\nbasis = 4\n";
+    const Scene a = scene(spectral, pinned);
+    const std::shared_ptr<const PreparedSpectral> first = prepare_spectral(a, options());
+    ASSERT_NE(first->diffuse, nullptr);
+    EXPECT_EQ(kept(*first), std::vector<bool>({false, false, false}));
+    std::vector<std::string> other = pinned;
+    other.push_back("bands=[\"V\", \"sdss_g\"]");  // two planes instead of three, on the same table
+    other.push_back("dust.tables={V = \"smooth.h5\", sdss_g = \"smooth.h5\"}");
+    const Scene b = scene(spectral, other);
+    const std::shared_ptr<const PreparedSpectral> second = prepare_spectral(b, options(), first.get());
+    EXPECT_EQ(kept(*second), all);
+    EXPECT_EQ(second->bake, first->bake);
+    EXPECT_EQ(second->diffuse, first->diffuse);
+    EXPECT_EQ(second->report.diffuse.seconds, first->report.diffuse.seconds);  // the bake reported is the one kept
+    expect_fresh_image(*second, b);
+    expect_fresh_image(*first, a);  // the first preparation is left as it was
+  }
+  const std::string spectral = "method = \"projection\"\nbasis = 4\n";
+  const Scene a = scene(spectral, pinned);
+  const std::shared_ptr<const PreparedSpectral> first = prepare_spectral(a, options());
+  // A star's power: its depth bake is kept; the fields (its light) and the model are made again.
+  std::vector<std::string> dimmer = pinned;
+  dimmer.push_back("stars.0.luminosity_lsun=1e5");
+  const Scene dim = scene(spectral, dimmer);
+  const std::shared_ptr<const PreparedSpectral> again = prepare_spectral(dim, options(), first.get());
+  EXPECT_EQ(kept(*again), std::vector<bool>({false, true, false}));
+  EXPECT_EQ(again->bake, first->bake);
+  EXPECT_NE(again->diffuse, first->diffuse);
+  expect_fresh_image(*again, dim);
+  // A star moved: nothing is kept.
+  std::vector<std::string> moved = pinned;
+  moved.push_back("stars.0.position=[1.1, 1, 1]");
+  const std::shared_ptr<const PreparedSpectral> elsewhere = prepare_spectral(scene(spectral, moved), options(), first.get());
+  EXPECT_EQ(kept(*elsewhere), std::vector<bool>({false, false, false}));
+  // Unpinned, the range is the bands' span: new bands of another span take a new basis, nodes and fields...
+  const std::string tables = "dust.tables={V = \"smooth.h5\", Halpha = \"smooth.h5\"}";
+  const Scene narrow = scene(spectral, {"render.diffuse_photons=65536", "bands=[\"V\", \"Halpha\"]", tables});
+  const std::shared_ptr<const PreparedSpectral> other = prepare_spectral(narrow, options(), first.get());
+  EXPECT_EQ(kept(*other), std::vector<bool>({false, true, false}));
+  EXPECT_LT(other->model.hi_um - other->model.lo_um, 0.7 - 0.35);
+  expect_fresh_image(*other, narrow);
+  // ... and bands of the same span (reordered) keep everything.
+  const Scene reordered = scene(spectral, {"render.diffuse_photons=65536", "bands=[\"Halpha\", \"V\"]", tables});
+  const std::shared_ptr<const PreparedSpectral> same = prepare_spectral(reordered, options(), other.get());
+  EXPECT_EQ(kept(*same), all);
+  expect_fresh_image(*same, reordered);
+}
+
 // Sweeps and the Python module render through a RenderSession: a [spectral]
 // scene there is the spectral renderer's image, as `nebula render` gives it,
 // its overrides applied (here the camera).
@@ -416,6 +486,19 @@ TEST_F(SpectralScene, ASessionRendersItWithTheSpectralRenderer) {
   moved_scene.camera.position = {2.5, -2, 1.6};
   EXPECT_EQ(moved.image.pixels, render_scene(moved_scene, options()).image.pixels);
   EXPECT_NE(moved.image.pixels, first.image.pixels);
+  // A camera edit kept the preparation whole: its depth bake, model and fields.
+  EXPECT_FALSE(first.report.bake.reused);
+  EXPECT_TRUE(moved.report.bake.reused);
+  EXPECT_TRUE(moved.report.spectral->basis_kept);
+  EXPECT_TRUE(moved.report.diffuse.reused);
+  // A star's power: the depth bake alone is kept, and the image is the whole render's.
+  const RenderOutput dimmer = session.render({"stars.0.luminosity_lsun=1e5"});
+  EXPECT_TRUE(dimmer.report.bake.reused);
+  EXPECT_FALSE(dimmer.report.diffuse.reused);
+  EXPECT_EQ(dimmer.image.pixels,
+            render_scene(scene("method = \"projection\"\nbasis = 4\n",
+                               {"render.diffuse_photons=65536", "stars.0.luminosity_lsun=1e5"}),
+                         options()).image.pixels);
 }
 
 TEST_F(SpectralScene, BadSettingsNameTheKeyAndWriteNothing) {

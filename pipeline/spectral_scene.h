@@ -66,11 +66,33 @@ struct PreparedSpectral {
   std::shared_ptr<const ScatteringTable> table;                    // the dust's, or null
   std::vector<std::shared_ptr<const ScatteringTable>> node_tables;  // albedo and g varying with wavelength
   std::shared_ptr<BakeResult> bake;  // shared, not const: the views' CUDA passes keep its device copies
-  std::optional<SpectralDiffuseFields> diffuse;
+  std::shared_ptr<const SpectralDiffuseFields> diffuse;  // or null
   int table_nodes = 0, emission_components = 0;
   bool tables = false;
+  // What each part depends on, to be kept by a later preparation (empty for
+  // a scene built in code: nothing is kept). The fields: the scene's resolved
+  // text without its bands, filters, view, basis range and per-band dust,
+  // with the options; the model: its [spectral], [dust] and [[stars]] tables;
+  // the depth bakes: star_bake_key.
+  std::string depends_on, model_key, bake_key;
 };
-std::shared_ptr<const PreparedSpectral> prepare_spectral(const Scene& scene, const RenderOptions& options);
+// With `previous` (an earlier preparation, its scene still alive), what the
+// changes left unchanged is taken over instead of made again, as the band
+// renderer's prepare_grid does after an edit:
+// - the depth bakes, when the grid and the stars' positions are the same
+//   (report.bake.reused);
+// - the model (basis and star tables), when the [spectral] settings, the
+//   dust's law and R_V and the stars are the same and so is the basis'
+//   wavelength range (spectral.range_um, or the bands' span); new filters
+//   then go onto it (spectral::set_filters: the projection, light_density,
+//   voxel_light and preintegrated methods; the others build anew)
+//   (report.spectral->basis_kept);
+// - the light between voxels' fields, when besides the bakes nothing else
+//   changed but the filters and the view: the same table, albedo, g and
+//   nodes (report.diffuse.reused).
+// The image is a fresh preparation's, bit for bit.
+std::shared_ptr<const PreparedSpectral> prepare_spectral(const Scene& scene, const RenderOptions& options,
+                                                         const PreparedSpectral* previous = nullptr);
 RenderOutput render_prepared_spectral(const PreparedSpectral& prepared, const CameraSettings& camera);
 
 }  // namespace nebula
