@@ -614,8 +614,8 @@ int run(const Args& args) {
       }
       if (scene.spectral && ImGui::CollapsingHeader("Filters", ImGuiTreeNodeFlags_DefaultOpen)) {
         // The spectral renderer integrates through any filter: each plane's
-        // filter, picked from those `nebula filters` lists (the model is built
-        // again for them; docs/spectral.md).
+        // filter, picked from those `nebula filters` lists (put on the prepared
+        // basis when it holds them, no bake; docs/spectral.md).
         static const std::vector<FilterInfo> known = known_filters();
         for (size_t b = 0; b < scene.bands.size(); ++b) {
           const std::string label = "plane " + std::to_string(b + 1);
@@ -625,7 +625,7 @@ int run(const Args& args) {
               if (ImGui::Selectable(f.name.c_str(), selected) && !selected) {
                 std::vector<std::string> bands = scene.bands;
                 bands[b] = f.name;
-                edit("bands", toml_strings(bands));
+                session.set_filters(bands);  // on the prepared basis when it holds them
               }
               if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", f.source.c_str());
             }

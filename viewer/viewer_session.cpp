@@ -148,7 +148,8 @@ struct Session::Baked {
         prepared(per_frame()                              ? PreparedGrid{}
                  : previous && !previous->per_frame() ? prepare_grid(*scene, o, previous->prepared)
                                                           : prepare_grid(*scene, o)),
-        spectral(scene->spectral ? prepare_spectral(*scene, o) : nullptr) {
+        spectral(scene->spectral ? prepare_spectral(*scene, o, previous ? previous->spectral.get() : nullptr)
+                                 : nullptr) {
     // The previews' coarser grid (ViewerOptions::preview_coarsening), its bakes reused alike.
     const bool pyramid = scene->pyramid_levels > 0 || scene->multiple_scattering == MultipleScattering::Pyramid;
     if (per_frame() || pyramid || coarsening <= 0) return;
@@ -199,6 +200,44 @@ void Session::edit(const std::string& key, const std::string& value) {
     source_.set(key, value);
     ++wanted_version_;
     why_ = key + " changed";
+  }
+  wake_.notify_all();
+}
+
+void Session::set_filters(const std::vector<std::string>& bands) {
+  // The span of the new filters (the grey band has none).
+  double lo = 1e30, hi = 0;
+  for (const std::string& name : bands) {
+    const Passband filter = band_filter(*shown_scene_, name);
+    if (filter.wavelength_nm.empty()) continue;
+    lo = std::min(lo, filter.wavelength_nm.front() / 1000.0);
+    hi = std::max(hi, filter.wavelength_nm.back() / 1000.0);
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<std::string> now = source_.overrides();
+    const bool ours = !kept_range_.empty() &&
+                      std::find(now.begin(), now.end(), "spectral.range_um=" + kept_range_) != now.end();
+    const SpectralSpec* spec = shown_scene_->spectral ? &*shown_scene_->spectral : nullptr;
+    const bool scene_pins = spec && (spec->range_lo_um > 0 || spec->range_hi_um > 0) && !ours;
+    const PreparedSpectral* prepared = baked_ && baked_->spectral ? baked_->spectral.get() : nullptr;
+    source_.set("bands", toml_strings(bands));
+    why_ = "filters changed";
+    if (!scene_pins && prepared) {
+      const double range_lo = prepared->model.lo_um, range_hi = prepared->model.hi_um;
+      char range[96];
+      std::snprintf(range, sizeof range, "%.3g-%.3g um", range_lo, range_hi);
+      if (lo >= range_lo && hi <= range_hi) {
+        kept_range_ = "[" + toml_number(range_lo) + ", " + toml_number(range_hi) + "]";
+        source_.set("spectral.range_um", kept_range_);
+        why_ += std::string(" (on the basis of ") + range + ": tables and bakes kept)";
+      } else {
+        if (ours) source_.unset("spectral.range_um");
+        kept_range_.clear();
+        why_ += std::string(" (outside the basis' ") + range + ": model and bakes made again)";
+      }
+    }
+    ++wanted_version_;
   }
   wake_.notify_all();
 }

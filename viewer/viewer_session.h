@@ -131,6 +131,14 @@ class Session {
   // the change in the status ("dust.albedo changed"). Camera and display keys
   // belong to the front end and need no bake.
   void edit(const std::string& key, const std::string& value);
+  // A [spectral] scene's filters, one per plane (the Filters panel): the edit
+  // of `bands`. When they lie within the wavelength range of the basis shown,
+  // that range is kept as spectral.range_um (an override, so the scene saved
+  // renders the same image) and the worker puts the filters on the prepared
+  // basis without baking again (prepare_spectral's `previous`); outside it,
+  // the range this made goes and the scene is prepared afresh. A range the
+  // scene itself sets is left alone. Error for an unknown filter (no change).
+  void set_filters(const std::vector<std::string>& bands);
   // Render this view next; a newer request replaces it. preview: the quick
   // frame for a moving camera (each voxel's light taken once per view,
   // MarchMode::voxel_sources; axial and spectral scenes render as usual).
@@ -184,6 +192,7 @@ class Session {
   SceneSource source_;
   uint64_t wanted_version_ = 1, baked_version_ = 0;
   std::string why_ = "the scene was opened";
+  std::string kept_range_;  // the spectral.range_um override set_filters made ("" for none)
   std::optional<CameraSettings> wanted_camera_;
   bool wanted_preview_ = false;
   uint64_t wanted_request_ = 0, rendered_request_ = 0;

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -157,15 +159,36 @@ TEST_F(ViewerSession, ASpectralScenesFiltersChangeAtRunTime) {
   const Frame before = frame_of(s, camera);
   const std::vector<std::string> sdss = {"sdss_g", "sdss_r", "sdss_i"};
   EXPECT_EQ(toml_strings(sdss), "[\"sdss_g\", \"sdss_r\", \"sdss_i\"]");
-  s.edit("bands", toml_strings(sdss));
+  // SDSS g, r, i lie within B-R's 0.36-0.90 um: the basis, tables and bakes are kept, the range
+  // is kept in the scene, and the frame is `nebula render`'s image of the scene as it now stands.
+  s.set_filters(sdss);
   const Frame after = frame_of(s, camera);
   EXPECT_TRUE(s.status().error.empty()) << s.status().error;
   ASSERT_EQ(after.image.bands, sdss);
+  ASSERT_TRUE(s.status().report.spectral.has_value());
+  EXPECT_TRUE(s.status().report.spectral->basis_kept);
+  EXPECT_TRUE(s.status().report.diffuse.reused);
+  const std::vector<std::string> kept = s.source().overrides();
+  EXPECT_NE(std::find_if(kept.begin(), kept.end(),
+                         [](const std::string& k) { return k.rfind("spectral.range_um=[0.3", 0) == 0; }),
+            kept.end());
   RenderOptions o;
   o.table_photons = 1000;
-  EXPECT_EQ(render_scene(load_scene_text(text, "v.toml", ".", {"bands=" + toml_strings(sdss)}), o).image.pixels,
-            after.image.pixels);
+  EXPECT_EQ(render_scene(load_scene_text(text, "v.toml", ".", kept), o).image.pixels, after.image.pixels);
   EXPECT_NE(before.image.pixels, after.image.pixels);
+  // U reaches 0.30 um, outside that basis: the range kept goes, and the scene is prepared afresh.
+  const std::vector<std::string> ubv = {"U", "B", "V"};
+  s.set_filters(ubv);
+  const Frame wider = frame_of(s, camera);
+  EXPECT_TRUE(s.status().error.empty()) << s.status().error;
+  ASSERT_EQ(wider.image.bands, ubv);
+  EXPECT_FALSE(s.status().report.spectral->basis_kept);
+  EXPECT_TRUE(s.status().report.bake.reused);  // the stars' depths do not depend on the filters
+  EXPECT_FALSE(s.status().report.diffuse.reused);
+  const std::vector<std::string> afresh = s.source().overrides();
+  EXPECT_EQ(afresh, std::vector<std::string>{"bands=" + toml_strings(ubv)});
+  EXPECT_EQ(render_scene(load_scene_text(text, "v.toml", ".", afresh), o).image.pixels, wider.image.pixels);
+  EXPECT_THROW(s.set_filters({"no_such_filter"}), Error);
   EXPECT_THROW(toml_strings({"a\"b"}), Error);
 }
 
