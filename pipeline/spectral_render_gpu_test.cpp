@@ -5,6 +5,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "core/test_support.h"
 #include "pipeline/run_setup.h"
@@ -20,7 +23,7 @@ namespace {
 
 class SpectralSceneGpu : public testing::TempDirTest {
  protected:
-  Scene scene() {
+  Scene scene(const std::vector<std::string>& overrides = {}) {
     write_table(testing::make_test_table(10.0, 1001, AngularBinning::UniformTheta, 180, 0.6), path("smooth.h5"), true);
     return load_scene(write_text("scene.toml", "bands = [\"B\", \"V\", \"R\"]\n"
                                                "[dust]\ntables = { B = \"smooth.h5\", V = \"smooth.h5\", R = \"smooth.h5\" }\n"
@@ -30,7 +33,8 @@ class SpectralSceneGpu : public testing::TempDirTest {
                                                "position = [1.4, 1.0, 1.1]\n"
                                                "[camera]\nposition = [1, -2.5, 1]\nlook_at = [1, 1, 1]\n"
                                                "width = 48\nheight = 40\n[render]\ndiffuse_photons = 262144\n"
-                                               "[spectral]\nmethod = \"projection\"\nbasis = 4\n"));
+                                               "[spectral]\nmethod = \"projection\"\nbasis = 4\n"),
+                      overrides);
   }
 };
 
@@ -108,6 +112,31 @@ TEST_F(SpectralSceneGpu, PreparedOnceEachViewIsTheWholeRender) {
     whole.camera = camera;
     const double d = worst_of_peak(render_prepared_spectral(*prepared, camera).image, render_scene(whole, o).image);
     std::printf("  a view of the prepared scene against its whole render, CUDA: %.3g of the peak\n", d);
+    EXPECT_LT(d, 1e-5);
+  }
+}
+
+// A preparation after an edit on the GPU keeps what the edit left unchanged
+// (the depth bakes with their device copies, the fields left on the device):
+// new filters keep all of it, a star's power its depth bakes; each image is
+// the whole render of the edited scene on the GPU.
+TEST_F(SpectralSceneGpu, APreparationKeepsWhatTheEditLeftUnchanged) {
+  NEBULA_SKIP_WITHOUT_GPU();
+  RenderOptions o;
+  o.backend = Backend::Cuda;
+  const std::string range = "spectral.range_um=[0.3, 1.0]";
+  const Scene a = scene({range});
+  const std::shared_ptr<const PreparedSpectral> first = prepare_spectral(a, o);
+  const Scene filters = scene({range, "bands=[\"V\", \"sdss_g\"]", "dust.tables={V = \"smooth.h5\", sdss_g = \"smooth.h5\"}"});
+  const Scene dimmer = scene({range, "stars.1.luminosity_lsun=3e4"});
+  const std::shared_ptr<const PreparedSpectral> second = prepare_spectral(filters, o, first.get());
+  const std::shared_ptr<const PreparedSpectral> third = prepare_spectral(dimmer, o, second.get());
+  EXPECT_TRUE(second->report.spectral->basis_kept && second->report.bake.reused && second->report.diffuse.reused);
+  EXPECT_TRUE(third->report.bake.reused);
+  EXPECT_FALSE(third->report.diffuse.reused);
+  for (const auto& [prepared, s] : {std::pair{second, &filters}, std::pair{third, &dimmer}, std::pair{first, &a}}) {
+    const double d = worst_of_peak(render_prepared_spectral(*prepared, s->camera).image, render_scene(*s, o).image);
+    std::printf("  a kept preparation's view against the whole render, CUDA: %.3g of the peak\n", d);
     EXPECT_LT(d, 1e-5);
   }
 }
