@@ -57,14 +57,14 @@ MarchScene assemble_march_scene(const RenderInputs& in, Place& place) {
   }
   scene.stars = place_star_views(in.stars, scene.n_bands, place);
   scene.n_stars = static_cast<int>(in.stars.size());
-  // The rays that may take chord_phase_mean (uniform-theta tables); the
-  // longest chord through a voxel is its diagonal.
+  // The rays that may take chord_phase_mean (uniform-theta tables), by the
+  // longest chord a voxel gives each ray (NearStarRadius).
   int n_mu = 0;
   for (int b = 0; b < scene.n_bands; ++b)
     if (scene.albedo[b] > 0.0f && scene.table[b].bins.kind == AngularBinning::UniformTheta &&
         scene.table[b].n_mu > n_mu)
       n_mu = scene.table[b].n_mu;
-  scene.near_star_radius = chord_phase_radius(std::sqrt(3.0f) * in.density->shape.voxel, n_mu);
+  scene.near_star_radius = NearStarRadius::phase(in.density->shape.voxel, n_mu);
   if (in.diffuse) {
     scene.has_diffuse = true;
     scene.diffuse = place_diffuse(*in.diffuse, place);
@@ -73,7 +73,7 @@ MarchScene assemble_march_scene(const RenderInputs& in, Place& place) {
     // one (a table with few angle bins has a smaller phase radius), so the
     // image has no seam where the near rays end.
     if (scene.diffuse.zonal > 0)
-      scene.near_star_radius = std::max(scene.near_star_radius, scene.chord_field_radius);
+      scene.near_star_radius.fixed = scene.chord_field_radius;
   }
   return scene;
 }

@@ -52,8 +52,9 @@ struct MarchScene {
   // raycast/voxel_sources.h; the march then only carries it to the eye.
   const float* voxel_source[kMaxBands] = {};
   // Rays passing farther than this from every star take the star's phase at
-  // each chord's half-light point (passes_near_a_star, chord_phase_radius).
-  float near_star_radius = 0.0f;
+  // each chord's half-light point (passes_near_a_star; NearStarRadius, by the
+  // ray's direction).
+  NearStarRadius near_star_radius;
   // Near rays' chords within this of a zonal star take the field's light on
   // the chord (add_chord_field_light), the others the per-view pass's:
   // kChordFieldVoxels voxels (march_scene.h).

@@ -187,12 +187,14 @@ TEST(Renderer, PixelsNearAStarHoldTheirAreaMean) {
     }
 }
 
-// The rays passes_near_a_star leaves out have no chord (of at most a voxel's
-// diagonal) that chord_phase_mean would average, and pass no star within 4 of
-// their pixels' widths: the CPU loop and the CUDA launch split the rays there
-// without changing the image (the far rays' chord_irradiance<false> is the
-// near one's, bit for bit). Pixels wide against the phase's radius (the
-// second footprint) make the widths decide.
+// The rays passes_near_a_star leaves out have no chord (of at most the
+// longest a voxel gives their direction, l / max_i |dir_i|) that
+// chord_phase_mean would average, and pass no star within 4 of their pixels'
+// widths: the CPU loop and the CUDA launch split the rays there without
+// changing the image (the far rays' chord_irradiance<false> is the near one's,
+// bit for bit). Pixels wide against the phase's radius (the second footprint)
+// make the widths decide. The radius by direction leaves out rays that the
+// diagonal's would have taken; a fixed radius (the zonal field's) still holds.
 TEST(Renderer, RaysFarFromEveryStarKeepTheHalfLightPoint) {
   const float l = 0.05f;
   const int n_mu = 72;
@@ -204,19 +206,22 @@ TEST(Renderer, RaysFarFromEveryStarKeepTheHalfLightPoint) {
   star.position = {0.3f, -0.2f, 0.1f};
   scene.stars = &star;
   scene.n_stars = 1;
-  scene.near_star_radius = chord_phase_radius(std::sqrt(3.0f) * l, n_mu);
+  scene.near_star_radius = NearStarRadius::phase(l, n_mu);
+  const float diagonal_radius = chord_phase_radius(std::sqrt(3.0f) * l, n_mu);
+  EXPECT_FLOAT_EQ(scene.near_star_radius.largest(), diagonal_radius);
   const RayFootprint footprints[] = {{0.0f, 0.002f, {1, 0, 0}, {0, 1, 0}}, {0.3f, 0.1f, {0.6f, 0.8f, 0}, {-0.8f, 0.6f, 0}}};
   for (const RayFootprint& footprint : footprints) {
     scene.footprint = footprint;
     UniformStream rng(7, 0, 0, 0);
-    int far = 0, near_averaged = 0, far_within_widths = 0;
+    int far = 0, near_averaged = 0, far_within_widths = 0, far_within_diagonal = 0;
     for (int i = 0; i < 200000; ++i) {
       const Vec3 origin{4 * rng.next() - 2, 4 * rng.next() - 2, 4 * rng.next() - 2};
       Vec3 dir{rng.next() - 0.5f, rng.next() - 0.5f, rng.next() - 0.5f};
       dir = normalize(dir);
       // A chord on the ray near its closest approach to the star (or its start).
       const float tc = fmaxf(dot(star.position - origin, dir), 0.0f);
-      const float t0 = fmaxf(tc + (rng.next() - 0.5f) * 4 * l, 0.0f), t1 = t0 + std::sqrt(3.0f) * l * rng.next();
+      const float longest = l / fmaxf(fabsf(dir.x), fmaxf(fabsf(dir.y), fabsf(dir.z)));
+      const float t0 = fmaxf(tc + (rng.next() - 0.5f) * 4 * l, 0.0f), t1 = t0 + longest * std::sqrt(rng.next());
       const ChordIrradiance at = chord_irradiance(origin, dir, t0, t1, star.position, footprint);
       const bool mean = chord_takes_phase_mean(table, at.a0, at.a1);
       if (!passes_near_a_star(scene, origin, dir)) {
@@ -226,19 +231,44 @@ TEST(Renderer, RaysFarFromEveryStarKeepTheHalfLightPoint) {
         ASSERT_EQ(cheap.inv_r2, at.inv_r2) << "ray " << i;
         ASSERT_EQ(cheap.a0, at.a0) << "ray " << i;
         ASSERT_EQ(cheap.a1, at.a1) << "ray " << i;
+        const Vec3 to_star = star.position - origin;
+        const Vec3 chords_off = dot(to_star, dir) > 0.0f ? to_star - dot(to_star, dir) * dir : to_star;
+        far_within_diagonal += dot(chords_off, chords_off) < diagonal_radius * diagonal_radius;
       } else if (mean) {
         ++near_averaged;
       } else {
         const Vec3 to_star = star.position - origin;
         const Vec3 off = to_star - tc * dir;
-        far_within_widths += dot(off, off) >= scene.near_star_radius * scene.near_star_radius;
+        const float r = scene.near_star_radius.along(dir);
+        far_within_widths += dot(off, off) >= r * r;
       }
     }
     EXPECT_GT(far, 1000);
     EXPECT_GT(near_averaged, 1000);
+    // Narrow pixels: the direction decides (wide ones are near within the diagonal's radius by their widths).
+    if (footprint.width_at_eye == 0.0f) EXPECT_GT(far_within_diagonal, 1000);
     // The wide pixels make some rays near by their widths alone.
     if (footprint.width_at_eye > 0.0f) EXPECT_GT(far_within_widths, 1000);
   }
+  // A fixed radius beyond the phase's holds along every direction.
+  scene.footprint = footprints[0];
+  scene.near_star_radius.fixed = 4.0f * diagonal_radius;
+  UniformStream rng(9, 0, 0, 0);
+  int within_fixed = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3 origin{4 * rng.next() - 2, 4 * rng.next() - 2, 4 * rng.next() - 2};
+    const Vec3 dir = normalize(Vec3{rng.next() - 0.5f, rng.next() - 0.5f, rng.next() - 0.5f});
+    const Vec3 to_star = star.position - origin;
+    const Vec3 off = dot(to_star, dir) > 0.0f ? to_star - dot(to_star, dir) * dir : to_star;
+    const float d = std::sqrt(dot(off, off));
+    if (d < 0.99f * scene.near_star_radius.fixed) {
+      ++within_fixed;
+      ASSERT_TRUE(passes_near_a_star(scene, origin, dir)) << "ray " << i;
+    } else if (d > 1.01f * scene.near_star_radius.fixed) {
+      ASSERT_FALSE(passes_near_a_star(scene, origin, dir)) << "ray " << i;
+    }
+  }
+  EXPECT_GT(within_fixed, 100);
 }
 
 TEST(Renderer, PureExtinctionThroughASlab) {

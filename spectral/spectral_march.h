@@ -182,9 +182,10 @@ struct SpectralSceneView {
   const float* node_table = nullptr;
   int node_table_rows = 0;
   float node_table_inv_step = 1;  // rows per unit of tau_V
-  // Rays within this distance of a star take the phase's mean over their chords' angles
-  // (march_spectral<kMethod, true>; tables/chord_phase.h); 0: none (the thin limit, uniform-mu tables).
-  float near_star_radius = 0.0f;
+  // Rays within this distance of a star (by their direction: NearStarRadius) take the phase's
+  // mean over their chords' angles (march_spectral<kMethod, true>; tables/chord_phase.h); 0:
+  // none (the thin limit, uniform-mu tables).
+  NearStarRadius near_star_radius;
   const float* lambda_albedo = nullptr;
   const float* lambda_g = nullptr;
 };

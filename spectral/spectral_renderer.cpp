@@ -93,7 +93,7 @@ void set_table(SpectralSceneView& view, const SpectralRenderInputs& in, const fl
   }
   // The rays that can have chords seeing a star over several angle bins (tables/chord_phase.h).
   if (view.table.bins.kind == AngularBinning::UniformTheta && view.table.C)
-    view.near_star_radius = chord_phase_radius(std::sqrt(3.0f) * in.density->shape.voxel, view.table.n_mu);
+    view.near_star_radius = NearStarRadius::phase(in.density->shape.voxel, view.table.n_mu);
 }
 
 NodeTable node_table(const SpectralRenderInputs& in, const SpectralSceneView& view) {

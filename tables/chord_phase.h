@@ -48,17 +48,40 @@ inline float chord_phase_radius(float chord, int n_mu) {
   return 1.01f * chord * float(n_mu) / (kChordPhaseMinBins * kPi);
 }
 
+// How far from a star a ray counts as near (passes_near_a_star). The phase's
+// radius grows with the longest chord a voxel can give the ray: a voxel of
+// edge l cut along unit `dir` gives at most l / max_i |dir_i| (its slab
+// across the dominant axis), the diagonal sqrt(3) l only along a diagonal,
+// so a ray along an axis is near only within 1/sqrt(3) of the diagonal's
+// radius. `fixed`: a radius that holds whatever the direction (the zonal
+// field on the chords, raycast/march_scene.h).
+struct NearStarRadius {
+  float per_chord = 0.0f;  // chord_phase_radius per unit of chord length (0: no phase means)
+  float voxel = 0.0f;      // the voxel's edge
+  float fixed = 0.0f;
+  // The phase's radius for the table's n_mu bins and voxels of edge l.
+  static NearStarRadius phase(float l, int n_mu) { return {chord_phase_radius(1.0f, n_mu), l, 0.0f}; }
+  // Along unit dir.
+  NEBULA_HD float along(Vec3 dir) const {
+    const float dominant = fmaxf(fabsf(dir.x), fmaxf(fabsf(dir.y), fabsf(dir.z)));
+    const float phase = per_chord > 0.0f ? per_chord * voxel / dominant : 0.0f;
+    return fmaxf(phase, fixed);
+  }
+  // The largest over every direction (along a voxel's diagonal).
+  NEBULA_HD float largest() const { return fmaxf(per_chord * voxel * 1.7320508f, fixed); }
+};
+
 // Whether a ray from `origin` along unit `dir` passes within `radius`
-// (chord_phase_radius) of one of the n stars (each with a .position), or
+// (NearStarRadius::along) of one of the n stars (each with a .position), or
 // within 4 of its pixel's widths there (the footprint): only such rays have
 // chords whose angles chord_phase_mean averages or whose pixel's mean of 1/b
 // needs its closed form (illumination/chord_irradiance.h), so the marchers
 // march the others without them (their kernels keep their registers) and
 // give the same image.
 template <class Star>
-NEBULA_HD bool passes_near_a_star(const Star* stars, int n, float radius, const RayFootprint& footprint, Vec3 origin,
-                                  Vec3 dir) {
-  const float r2 = radius * radius;
+NEBULA_HD bool passes_near_a_star(const Star* stars, int n, const NearStarRadius& radius,
+                                  const RayFootprint& footprint, Vec3 origin, Vec3 dir) {
+  const float r = radius.along(dir), r2 = r * r;
   for (int k = 0; k < n; ++k) {
     const Vec3 to_star = stars[k].position - origin;
     const float tc = dot(to_star, dir);
