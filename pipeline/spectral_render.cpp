@@ -147,6 +147,16 @@ spectral::SpectralDiffuseLight spectral_diffuse_light(const Scene& scene, const 
   return spectral_diffuse_view(scene, fields, bake, camera, o.backend, view_seconds);
 }
 
+std::pair<double, double> filters_span_um(const std::vector<std::pair<std::string, Passband>>& filters) {
+  double lo = 1e30, hi = 0;
+  for (const auto& [name, band] : filters) {
+    if (band.wavelength_nm.empty()) continue;  // the grey band
+    lo = std::min(lo, band.wavelength_nm.front() / 1000.0);
+    hi = std::max(hi, band.wavelength_nm.back() / 1000.0);
+  }
+  return {lo, hi};
+}
+
 spectral::SpectralSettings spectral_settings(const Scene& scene) {
   if (!scene.spectral) throw Error(scene.path + ": spectral: the scene has no [spectral] table");
   const SpectralSpec& p = *scene.spectral;
@@ -227,12 +237,7 @@ std::string spectral_depends_on(const Scene& scene, const RenderOptions& o) {
 std::pair<double, double> basis_range(const spectral::SpectralSettings& settings,
                                       const std::vector<std::pair<std::string, Passband>>& filters) {
   if (settings.lo_um > 0 || settings.hi_um > 0) return {settings.lo_um, settings.hi_um};
-  double lo = 1e30, hi = 0;
-  for (const auto& [name, band] : filters) {
-    lo = std::min(lo, band.wavelength_nm.front() / 1000.0);
-    hi = std::max(hi, band.wavelength_nm.back() / 1000.0);
-  }
-  return {lo, hi};
+  return filters_span_um(filters);
 }
 
 bool same_table(const ScatteringTable* a, const ScatteringTable* b) {

@@ -20,6 +20,11 @@ namespace nebula {
 
 spectral::SpectralSettings spectral_settings(const Scene& scene);
 
+// The wavelengths (um) named filters span, {lo, hi}: the basis' range a fresh
+// model takes where the scene pins none (spectral.range_um). The grey band has
+// no wavelengths; none at all: {1e30, 0}.
+std::pair<double, double> filters_span_um(const std::vector<std::pair<std::string, Passband>>& filters);
+
 // The light between voxels in two steps: each star's field baked at the
 // model's table nodes (does not depend on the view), then, for a camera, the
 // fields' per-view pass.

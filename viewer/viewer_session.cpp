@@ -205,14 +205,9 @@ void Session::edit(const std::string& key, const std::string& value) {
 }
 
 void Session::set_filters(const std::vector<std::string>& bands) {
-  // The span of the new filters (the grey band has none).
-  double lo = 1e30, hi = 0;
-  for (const std::string& name : bands) {
-    const Passband filter = band_filter(*shown_scene_, name);
-    if (filter.wavelength_nm.empty()) continue;
-    lo = std::min(lo, filter.wavelength_nm.front() / 1000.0);
-    hi = std::max(hi, filter.wavelength_nm.back() / 1000.0);
-  }
+  std::vector<std::pair<std::string, Passband>> filters;
+  for (const std::string& name : bands) filters.emplace_back(name, band_filter(*shown_scene_, name));
+  const auto [lo, hi] = filters_span_um(filters);
   {
     std::lock_guard<std::mutex> lock(mutex_);
     std::vector<std::string> now = source_.overrides();
