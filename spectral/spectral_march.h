@@ -673,15 +673,16 @@ NEBULA_HD const float* star_integrals(const SpectralSceneView& s, int k, int p, 
 // with kFN = 0 it is the CPU's plain loop, which vectorises.
 template <int kFN = 0>
 NEBULA_HD void add_star_light(float* __restrict__ u, int stride, const float* __restrict__ q, int FN, float fd,
-                              float w, Vec3 grad) {
+                              float w, Vec3 grad, int i0 = 0) {
   NEBULA_UNROLL
-  for (int i = 0; i < (kFN > 0 ? kFN : FN); ++i) {
+  for (int j = 0; j < (kFN > 0 ? kFN : FN); ++j) {
+    const int i = i0 + j;
     if (kFN > 0 && i >= FN) break;
     const float v = q[i] + fd * (q[FN + i] - q[i]);
-    u[i] += w * v;
-    u[stride + i] += grad.x * v;
-    u[2 * stride + i] += grad.y * v;
-    u[3 * stride + i] += grad.z * v;
+    u[j] += w * v;
+    u[stride + j] += grad.x * v;
+    u[2 * stride + j] += grad.y * v;
+    u[3 * stride + j] += grad.z * v;
   }
 }
 
@@ -759,14 +760,16 @@ NEBULA_HD VoxelStarPair voxel_star_pair(const SpectralSceneView& s, const Camera
 // Q_p is formed first, then added as add_star_light adds w Q (the gradient
 // scaled by V / w: the table's own change with the angle across the voxel is
 // left out, slow beside p_HG's, whose change the gradient carries).
+// kFN > 0: the sums of outputs i0 .. i0 + kFN - 1 only (a slice: the GPU's
+// pre-pass gives each voxel several threads), u[j] standing for output i0 + j.
 template <int kFN = 0>
 NEBULA_HD void add_pair_light(const SpectralSceneView& s, float* __restrict__ u, int stride, int k, float tau_v,
-                              float w, float gx, float gy, float gz, float x, float mu) {
+                              float w, float gx, float gy, float gz, float x, float mu, int i0 = 0) {
   const int FN = s.n_acc * s.n_basis;
   const int d0 = int(x);
   const float fd = x - float(d0);
   if (s.n_nodes == 0) {
-    add_star_light<kFN>(u, stride, s.star_coeff + star_row(s, k, 0, d0), FN, fd, w, Vec3{gx, gy, gz});
+    add_star_light<kFN>(u, stride, s.star_coeff + star_row(s, k, 0, d0), FN, fd, w, Vec3{gx, gy, gz}, i0);
     return;
   }
   const PairWeights pw = pair_weights(s, w, tau_v, mu);
@@ -775,17 +778,18 @@ NEBULA_HD void add_pair_light(const SpectralSceneView& s, float* __restrict__ u,
   const float* q0 = s.star_coeff + star_row(s, k, 0, d0);
   const size_t block = size_t(s.n_depth) * FN;  // from one power's rows to the next's
   NEBULA_UNROLL
-  for (int i = 0; i < (kFN > 0 ? kFN : FN); ++i) {
+  for (int j = 0; j < (kFN > 0 ? kFN : FN); ++j) {
+    const int i = i0 + j;
     if (kFN > 0 && i >= FN) break;
     float v = 0.0f;
     for_each_index<kMaxTableNodes>(pw.n, [&](int p) {
       const float* q = q0 + size_t(p) * block;
       v += pw.b[p] * (q[i] + fd * (q[FN + i] - q[i]));
     });
-    u[i] += v;
-    u[stride + i] += rx * v;
-    u[2 * stride + i] += ry * v;
-    u[3 * stride + i] += rz * v;
+    u[j] += v;
+    u[stride + j] += rx * v;
+    u[2 * stride + j] += ry * v;
+    u[3 * stride + j] += rz * v;
   }
 }
 
@@ -794,7 +798,7 @@ NEBULA_HD void add_pair_light(const SpectralSceneView& s, float* __restrict__ u,
 // L_k sum_p B_p Q^p(k, D_d); the march weighs it by c_j(D_eye) as the star's
 // direct light.
 template <int kFN = 0>
-NEBULA_HD void add_diffuse_light(const SpectralSceneView& s, float* __restrict__ u, int k, size_t cell) {
+NEBULA_HD void add_diffuse_light(const SpectralSceneView& s, float* __restrict__ u, int k, size_t cell, int i0 = 0) {
   const int n = s.n_nodes, FN = s.n_acc * s.n_basis;
   const float* t = s.diffuse + (cell * s.n_stars + k) * size_t(n + 1);
   int d0;
@@ -804,14 +808,15 @@ NEBULA_HD void add_diffuse_light(const SpectralSceneView& s, float* __restrict__
   const float* q0 = s.star_coeff + star_row(s, k, 0, d0);
   const float power = s.stars[k].power;
   NEBULA_UNROLL
-  for (int i = 0; i < (kFN > 0 ? kFN : FN); ++i) {
+  for (int j = 0; j < (kFN > 0 ? kFN : FN); ++j) {
+    const int i = i0 + j;
     if (kFN > 0 && i >= FN) break;
     float v = 0.0f;
     for_each_index<kMaxTableNodes>(n, [&](int p) {
       const float* q = q0 + size_t(p) * block;
       v += t[p] * (q[i] + fd * (q[FN + i] - q[i]));
     });
-    u[i] += power * v;
+    u[j] += power * v;
   }
 }
 
@@ -822,13 +827,14 @@ NEBULA_HD void add_diffuse_light(const SpectralSceneView& s, float* __restrict__
 // through it do), into light[cell][4][F N]; near[cell] bit k: star k's pair
 // taken exactly in the march instead. Cost: voxels x stars, once per view.
 // The CPU runs rows of 16 voxels: first every star's pair per voxel side by
-// side (vectorised), then the sums star by star. The GPU runs one voxel per
-// thread (kRow 1) with kFN >= F N: star by star into 4 F N sums held in
-// registers, each output written once (kFN 0: the CPU's order, its per-star
-// arrays in local memory).
+// side (vectorised), then the sums star by star. The GPU runs a voxel's
+// outputs in slices of kFN (kRow 1), one thread each: star by star into the
+// slice's 4 kFN sums held in registers, each output written once; slice 0
+// writes the near mask (kFN 0: the CPU's order, its per-star arrays in local
+// memory). Every slice repeats the pairs' geometry; it holds fewer sums.
 template <int kRow, int kFN = 0>
 NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int x0, int y, int z, float* light,
-                           unsigned* near) {
+                           unsigned* near, int slice = 0) {
   const GridShape& g = s.density.shape;
   const int n = g.nx - x0 < kRow ? g.nx - x0 : kRow;
   const size_t cell0 = g.index(x0, y, z);
@@ -843,6 +849,7 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
   if constexpr (kRow == 1 && kFN > 0) {
     const Vec3 e = camera.to_eye(c0);
     const float inv_rho = inv_rho_of(c0), tau = s.density.tau_v[cell0];
+    const int i0 = slice * kFN;
     float u[4 * kFN];
     for_each_index<4 * kFN>(4 * kFN, [&](int i) { u[i] = 0.0f; });
     unsigned mask = 0;
@@ -851,18 +858,18 @@ NEBULA_HD void voxel_light(const SpectralSceneView& s, const Camera& camera, int
                                               inv_rho, tau, s.stars[k].depth_v[cell0]);
       mask |= unsigned(p.near != 0.0f) << k;
       if (p.w == 0.0f) continue;
-      add_pair_light<kFN>(s, u, kFN, k, tau, p.w, p.gx, p.gy, p.gz, p.x, p.mu);
+      add_pair_light<kFN>(s, u, kFN, k, tau, p.w, p.gx, p.gy, p.gz, p.x, p.mu, i0);
     }
     if (s.diffuse && tau > 0.0f)
-      for (int k = 0; k < s.n_stars; ++k) add_diffuse_light<kFN>(s, u, k, cell0);
-    float* out = light + cell0 * 4 * FN;
-    for_each_index<kFN>(FN, [&](int i) {
-      out[i] = u[i];
-      out[FN + i] = u[kFN + i];
-      out[2 * FN + i] = u[2 * kFN + i];
-      out[3 * FN + i] = u[3 * kFN + i];
+      for (int k = 0; k < s.n_stars; ++k) add_diffuse_light<kFN>(s, u, k, cell0, i0);
+    float* out = light + cell0 * 4 * FN + i0;
+    for_each_index<kFN>(FN - i0 < kFN ? FN - i0 : kFN, [&](int j) {
+      out[j] = u[j];
+      out[FN + j] = u[kFN + j];
+      out[2 * FN + j] = u[2 * kFN + j];
+      out[3 * FN + j] = u[3 * kFN + j];
     });
-    near[cell0] = mask;
+    if (slice == 0) near[cell0] = mask;
   } else {
     // Per voxel: the way to the eye, 1 / distance to it, the depth; one array per
     // component (not Vec3s), so that the loop over the voxels below vectorises.

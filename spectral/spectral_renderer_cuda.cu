@@ -70,21 +70,25 @@ __global__ void spectral_star_pixel_kernel(SpectralSceneView scene, Camera camer
   });
 }
 
-// VoxelLight's per-view pre-pass: one voxel per thread (spectral_march.h);
-// kFN >= F N keeps its sums in registers. With the table read at 3 attenuations
-// it took 156 registers, so one block of 256 threads (8 warps) per
-// multiprocessor: blocks of 128 held to 128 registers run 16 warps, and six
-// stars' frame went 2.02 -> 1.83 ms, one star's 1.47 -> 1.50 ms (H200, noise
-// cube 96^3, 512^2; blocks of 128 without the bound 1.94 ms; docs/performance.md).
+// VoxelLight's per-view pre-pass (spectral_march.h, voxel_light): each
+// voxel's F N outputs (and their gradients) in slices of kVoxelLightSlice, a
+// thread each, a voxel's slices side by side; each thread keeps its slice's
+// sums in registers and repeats the pairs' geometry. One voxel per thread with
+// every sum (slices of 16) took 128 registers at 25% occupancy and waited on
+// its reads; in slices of 16 / 8 / 4 / 2, H200, noise cube 96^3 at 512^2 with
+// the table at 3 attenuations, voxel light N = 4, six stars and one: 2.06 /
+// 1.96 / 1.73-1.79 / 1.93 ms and 1.51 / 1.33 / 1.06-1.09 / 1.08 ms
+// (docs/performance.md, "The voxel-light pre-pass in slices").
 constexpr int kVoxelLightBlock = 128;
-template <int kFN>
-__global__ void __launch_bounds__(kVoxelLightBlock, 4)
-    voxel_light_kernel(SpectralSceneView scene, Camera camera, float* light, unsigned* near) {
+constexpr int kVoxelLightSlice = 4;
+__global__ void __launch_bounds__(kVoxelLightBlock, 8)
+    voxel_light_kernel(SpectralSceneView scene, Camera camera, float* light, unsigned* near, int slices) {
   const GridShape& g = scene.density.shape;
-  const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  const size_t t = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  const size_t i = t / unsigned(slices);
   if (i >= g.count()) return;
   const int x = int(i % g.nx), y = int((i / g.nx) % g.ny), z = int(i / (size_t(g.nx) * g.ny));
-  voxel_light<1, kFN>(scene, camera, x, y, z, light, near);
+  voxel_light<1, kVoxelLightSlice>(scene, camera, x, y, z, light, near, int(t % unsigned(slices)));
 }
 
 // Light between voxels: each voxel's terms per star and its eye-side depth
@@ -258,12 +262,9 @@ Image render_spectral_cuda(const SpectralRenderInputs& in, double* seconds) {
                                               int(in.lights.size()), terms.get(), eye_tau.get());
   }
   if (voxel) {  // the pre-pass, timed with the march
-    const int FN = m.n_acc * int(m.basis.size());
-    const unsigned blocks = unsigned((cells + kVoxelLightBlock - 1) / kVoxelLightBlock);
-    if (FN <= 16)
-      voxel_light_kernel<16><<<blocks, kVoxelLightBlock>>>(view, in.camera, light.get(), near.get());
-    else
-      voxel_light_kernel<0><<<blocks, kVoxelLightBlock>>>(view, in.camera, light.get(), near.get());
+    const int FN = m.n_acc * int(m.basis.size()), slices = (FN + kVoxelLightSlice - 1) / kVoxelLightSlice;
+    const unsigned blocks = unsigned((cells * slices + kVoxelLightBlock - 1) / kVoxelLightBlock);
+    voxel_light_kernel<<<blocks, kVoxelLightBlock>>>(view, in.camera, light.get(), near.get(), slices);
   }
   dispatch_method(m.settings.method, [&](auto method) {
     with_accumulators<method()>(view, [&](auto acc) {
