@@ -67,8 +67,6 @@ struct NearStarRadius {
     const float phase = per_chord > 0.0f ? per_chord * voxel / dominant : 0.0f;
     return fmaxf(phase, fixed);
   }
-  // The largest over every direction (along a voxel's diagonal).
-  NEBULA_HD float largest() const { return fmaxf(per_chord * voxel * 1.7320508f, fixed); }
 };
 
 // Whether a ray from `origin` along unit `dir` passes within `radius`
